@@ -1,0 +1,792 @@
+r"""Build, then freeze: the mutable :class:`ModelBuilder` and the immutable Cartesian :class:`Model`.
+
+``ModelBuilder`` collects bodies, extra coordinates, joints, drivers and force elements; ``build()``
+validates them (every error names the element at fault), converts the joint locations to body-fixed
+markers, expands joints into vectorised primitive kinds, fixes the sparse pattern of ``Φ_q``, checks
+the initial configuration (or assembles it) and detects redundant constraints with a
+rank-revealing QR factorisation of ``Φ_qᵀ``.  The resulting :class:`Model` is an implementation of
+:class:`core.system.ConstrainedSystem` and is picklable.
+
+Mass matrix (constant, block diagonal; body-frame angular velocity for spatial bodies):
+``M = diag(m I, J̄)``; generalized forces add gravity ``m g`` and, spatial, the gyroscopic
+moment ``−ω̄ × J̄ ω̄`` (Nikravesh 1988, Eq. 11.22; Shabana 2013, Eq. 7.x).
+Energy ``T + V = ½ vᵀMv − Σ m gᵀr + Σ V_springs``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+from numpy.typing import ArrayLike, NDArray
+
+from . import frames
+from .bodies import PLANAR, SPATIAL, Body, BodyStates, Space
+from .constraints import PrimitiveKind
+from .forces import ForceElement, ForceJacobian, ForceKind
+from .joints import (
+    Cylindrical,
+    DistanceJoint,
+    Fixed,
+    Joint,
+    JointAngleDriver,
+    PointDriver,
+    Revolute,
+    Spherical,
+    Translational,
+    Universal,
+    UserConstraint,
+)
+from .system import ConstrainedSystem
+
+Array = NDArray[np.float64]
+GROUND = "ground"
+
+
+class ModelError(ValueError):
+    """Invalid model definition; the message names the element at fault."""
+
+
+class RedundantConstraintError(ModelError):
+    """Dependent constraint equations; ``dependent`` lists their names."""
+
+    def __init__(self, message: str, dependent: list[str]):
+        super().__init__(message)
+        self.dependent = dependent
+
+
+class AssemblyError(ModelError):
+    """The configuration cannot be assembled (Newton on Φ = 0 did not converge)."""
+
+
+@dataclass
+class ExtraCoordinate:
+    name: str
+    value: float
+    rate: float
+    mass: float
+
+
+class BuildContext:
+    """What element compilers may ask for at build time (body indices, initial frames)."""
+
+    def __init__(self, space: Space, body_names: list[str], bs0: BodyStates):
+        self.space = space
+        self._index = {n: k for k, n in enumerate(body_names)}
+        self._index[GROUND] = len(body_names)
+        self.bs0 = bs0
+
+    def index(self, body: str, element: str) -> int:
+        try:
+            return self._index[body]
+        except KeyError:
+            raise ModelError(f"element {element!r} refers to unknown body {body!r}") from None
+
+    def local_point(self, b: int, p: Array) -> Array:
+        return self.bs0.A[b].T @ (np.asarray(p, float) - self.bs0.r[b])
+
+    def local_vector(self, b: int, a: Array) -> Array:
+        return self.bs0.A[b].T @ np.asarray(a, float)
+
+    def angle(self, b: int) -> float:
+        A = self.bs0.A[b]
+        return float(np.arctan2(A[1, 0], A[0, 0]))
+
+
+class ModelBuilder:
+    """Mutable collector of a multibody model; ``build()`` returns a frozen :class:`Model`.
+
+    Parameters
+    ----------
+    dimension : {2, 3}
+        Planar (x, y, θ) or spatial (r, Euler parameters) bodies.
+    name : str
+    gravity : array_like, shape (dimension,)
+        Gravitational acceleration [m/s²]; default ``(0, −9.81)`` planar, ``(0, 0, −9.81)`` spatial.
+
+    Examples
+    --------
+    >>> b = ModelBuilder(2, "pendulum")
+    >>> _ = b.add_body("bob", mass=1.0, inertia=0.0, position=(1.0, 0.0))
+    >>> _ = b.add_revolute("pivot", "ground", "bob", at=(0.0, 0.0))
+    >>> model = b.build()
+    """
+
+    def __init__(self, dimension: int = 2, name: str = "model", gravity: ArrayLike | None = None):
+        if dimension not in (2, 3):
+            raise ModelError(f"model {name!r}: dimension must be 2 or 3, got {dimension}")
+        self.space: Space = PLANAR if dimension == 2 else SPATIAL
+        self.name = name
+        g = (0.0, -9.81) if dimension == 2 else (0.0, 0.0, -9.81)
+        self.gravity = np.asarray(g if gravity is None else gravity, float)
+        if self.gravity.shape != (dimension,):
+            raise ModelError(f"model {name!r}: gravity must have {dimension} components, got {self.gravity.tolist()}")
+        self.bodies: OrderedDict[str, Body] = OrderedDict()
+        self.extras: OrderedDict[str, ExtraCoordinate] = OrderedDict()
+        self.joints: OrderedDict[str, Joint | UserConstraint] = OrderedDict()
+        self.forces: OrderedDict[str, ForceElement] = OrderedDict()
+
+    # --- names ------------------------------------------------------------------------------
+    def _check_new(self, name: str, what: str) -> None:
+        if not isinstance(name, str) or not name:
+            raise ModelError(f"{what} name must be a non-empty string, got {name!r}")
+        if name == GROUND:
+            raise ModelError(f"{what} name {name!r} is reserved for the ground")
+        for table in (self.bodies, self.extras, self.joints, self.forces):
+            if name in table:
+                raise ModelError(f"duplicate name {name!r}: a {what} cannot reuse the name of an existing element")
+
+    # --- bodies -----------------------------------------------------------------------------
+    def add_body(self, name: str, mass: float, inertia, position, orientation=None, velocity=None,
+                 angular_velocity=None) -> str:
+        """Add a rigid body; see :class:`core.bodies.Body` for the parameters and units.
+
+        ``orientation`` is an angle [rad] (planar) or Euler parameters (spatial; normalised
+        here, error if far from unit length). ``angular_velocity`` is global for spatial bodies.
+        """
+        self._check_new(name, "body")
+        d = self.space.dim
+        pos = np.asarray(position, float)
+        if pos.shape != (d,) or not np.all(np.isfinite(pos)):
+            raise ModelError(f"body {name!r}: position must be {d} finite numbers, got {np.asarray(position).tolist()}")
+        if not (np.isfinite(mass) and mass >= 0):
+            raise ModelError(f"body {name!r}: mass must be ≥ 0, got {mass}")
+        vel = np.zeros(d) if velocity is None else np.asarray(velocity, float)
+        if vel.shape != (d,):
+            raise ModelError(f"body {name!r}: velocity must have {d} components")
+        if d == 2:
+            J = float(inertia)
+            if not (np.isfinite(J) and J >= 0):
+                raise ModelError(f"body {name!r}: polar moment of inertia must be ≥ 0, got {inertia}")
+            ori = 0.0 if orientation is None else float(orientation)
+            om = 0.0 if angular_velocity is None else float(angular_velocity)
+            body = Body(name, float(mass), J, pos, ori, vel, om)
+        else:
+            J = np.asarray(inertia, float)
+            if J.shape == (3,):
+                J = np.diag(J)
+            if J.shape != (3, 3) or not np.allclose(J, J.T) or np.any(np.linalg.eigvalsh(J) < -1e-15):
+                raise ModelError(f"body {name!r}: inertia must be a symmetric positive semi-definite 3×3 tensor (or 3 principal moments)")
+            p = np.array([1.0, 0, 0, 0]) if orientation is None else np.asarray(orientation, float)
+            if p.shape != (4,) or abs(np.linalg.norm(p) - 1.0) > 1e-6:
+                raise ModelError(f"body {name!r}: orientation must be 4 Euler parameters of unit norm, got {np.asarray(orientation).tolist()}")
+            om = np.zeros(3) if angular_velocity is None else np.asarray(angular_velocity, float)
+            if om.shape != (3,):
+                raise ModelError(f"body {name!r}: angular velocity must have 3 components")
+            body = Body(name, float(mass), J, pos, p / np.linalg.norm(p), vel, om)
+        self.bodies[name] = body
+        return name
+
+    def add_coordinate(self, name: str, value: float, rate: float = 0.0, mass: float = 0.0) -> str:
+        """Add an extra scalar coordinate (e.g. a path parameter) with optional inertia ``mass``."""
+        self._check_new(name, "coordinate")
+        self.extras[name] = ExtraCoordinate(name, float(value), float(rate), float(mass))
+        return name
+
+    # --- joints -----------------------------------------------------------------------------
+    def add_joint(self, joint: Joint | UserConstraint) -> Joint | UserConstraint:
+        """Add any joint, driver or user constraint object."""
+        self._check_new(joint.name, "joint")
+        bi, bj = getattr(joint, "body_i", GROUND), getattr(joint, "body_j", GROUND)
+        if not isinstance(joint, UserConstraint) and bi == bj:
+            raise ModelError(f"joint {joint.name!r} connects body {bi!r} to itself")
+        self.joints[joint.name] = joint
+        return joint
+
+    def add_revolute(self, name, body_i, body_j, at, axis=None) -> Revolute:
+        """Revolute joint at global point ``at`` (spatial: about global ``axis``)."""
+        return self.add_joint(Revolute(name, body_i, body_j, at, axis))
+
+    def add_spherical(self, name, body_i, body_j, at) -> Spherical:
+        return self.add_joint(Spherical(name, body_i, body_j, at))
+
+    def add_universal(self, name, body_i, body_j, at, axis_i, axis_j) -> Universal:
+        return self.add_joint(Universal(name, body_i, body_j, at, axis_i, axis_j))
+
+    def add_cylindrical(self, name, body_i, body_j, at, axis) -> Cylindrical:
+        return self.add_joint(Cylindrical(name, body_i, body_j, at, axis))
+
+    def add_translational(self, name, body_i, body_j, at, axis) -> Translational:
+        return self.add_joint(Translational(name, body_i, body_j, at, axis))
+
+    def add_fixed(self, name, body_i, body_j, at) -> Fixed:
+        return self.add_joint(Fixed(name, body_i, body_j, at))
+
+    def add_distance(self, name, body_i, body_j, point_i, point_j, length=None) -> DistanceJoint:
+        return self.add_joint(DistanceJoint(name, body_i, body_j, point_i, point_j, length))
+
+    def add_angle_driver(self, name, joint: str | Revolute, motion) -> JointAngleDriver:
+        """Drive the relative angle of revolute ``joint`` by ``motion`` (offset from its initial value)."""
+        j = self.joints.get(joint) if isinstance(joint, str) else joint
+        if not isinstance(j, Revolute):
+            raise ModelError(f"driver {name!r}: {joint!r} is not a revolute joint of this model")
+        return self.add_joint(JointAngleDriver(name, j, motion))
+
+    def add_point_driver(self, name, body, point, direction, motion) -> PointDriver:
+        """Drive a body point along a global ``direction`` by ``motion`` (offset from its initial value)."""
+        return self.add_joint(PointDriver(name, body, point, direction, motion))
+
+    # --- forces -----------------------------------------------------------------------------
+    def add_force(self, element: ForceElement) -> ForceElement:
+        """Add any force element (see :mod:`core.forces`)."""
+        self._check_new(element.name, "force element")
+        self.forces[element.name] = element
+        return element
+
+    def add_spring_damper(self, name, body_i, body_j, point_i, point_j, stiffness, damping=0.0,
+                          free_length=None, actuator=None):
+        from .forces import SpringDamper
+
+        return self.add_force(SpringDamper(name, body_i, body_j, point_i, point_j, stiffness, damping, free_length, actuator))
+
+    # --- build ------------------------------------------------------------------------------
+    def build(self, assemble: bool = False, redundant: str = "raise", tol: float = 1e-9) -> Model:
+        """Validate and freeze.
+
+        Parameters
+        ----------
+        assemble : bool
+            If True, correct the initial positions and velocities onto the constraints
+            (kinematic assembly, minimum-norm correction) instead of rejecting them.
+        redundant : {'raise', 'remove', 'keep'}
+            What to do with dependent constraint equations found at the initial configuration:
+            raise :class:`RedundantConstraintError` naming them; remove them (their reaction
+            share is then carried by the independent rows, a unique multiplier set, as Adams
+            does); or keep them (integrators then use minimum-norm multipliers).
+        tol : float
+            Tolerance on the initial constraint residual [m or rad] and on the rank decision.
+        """
+        if redundant not in ("raise", "remove", "keep"):
+            raise ModelError(f"model {self.name!r}: redundant must be 'raise', 'remove' or 'keep', got {redundant!r}")
+        if not self.bodies and not self.extras:
+            raise ModelError(f"model {self.name!r} has no bodies")
+        model = Model._from_builder(self)
+        if assemble:
+            from .analysis import assemble as _assemble
+
+            model = _assemble(model)
+        model._check_initial(tol)
+        model._check_redundancy(redundant, tol)
+        return model
+
+
+class Model(ConstrainedSystem):
+    """Frozen Cartesian multibody model (see module docstring). Create with :class:`ModelBuilder`."""
+
+    # ---------------------------------------------------------------------------------------
+    @classmethod
+    def _from_builder(cls, b: ModelBuilder) -> Model:
+        self = cls.__new__(cls)
+        sp_ = b.space
+        self.space = sp_
+        self.name = b.name
+        self.gravity = b.gravity.copy()
+        self.body_names = list(b.bodies)
+        self.n_bodies = nb = len(self.body_names)
+        self.extra_names = list(b.extras)
+        ne = len(self.extra_names)
+        self.n_q = nb * sp_.n_q + ne
+        self.n_v = nb * sp_.n_v + ne
+        bodies = list(b.bodies.values())
+        self.bodies = tuple(bodies)
+        # initial state -----------------------------------------------------------------------
+        q0, v0 = np.zeros(self.n_q), np.zeros(self.n_v)
+        for k, body in enumerate(bodies):
+            qs, vs = slice(k * sp_.n_q, (k + 1) * sp_.n_q), slice(k * sp_.n_v, (k + 1) * sp_.n_v)
+            if sp_.dim == 2:
+                q0[qs] = [*body.position, body.orientation]
+                v0[vs] = [*body.velocity, body.angular_velocity]
+            else:
+                q0[qs] = [*body.position, *body.orientation]
+                A = frames.euler_to_matrix(body.orientation)
+                v0[vs] = [*body.velocity, *(A.T @ body.angular_velocity)]
+        for k, ex in enumerate(b.extras.values()):
+            q0[nb * sp_.n_q + k] = ex.value
+            v0[nb * sp_.n_v + k] = ex.rate
+        self.q0, self.v0 = q0, v0
+        # names -------------------------------------------------------------------------------
+        qn = ("x", "y", "theta") if sp_.dim == 2 else ("x", "y", "z", "e0", "e1", "e2", "e3")
+        vn = ("vx", "vy", "omega") if sp_.dim == 2 else ("vx", "vy", "vz", "wx", "wy", "wz")
+        qu = ("[m]", "[m]", "[rad]") if sp_.dim == 2 else ("[m]",) * 3 + ("[-]",) * 4
+        vu = ("[m/s]", "[m/s]", "[rad/s]") if sp_.dim == 2 else ("[m/s]",) * 3 + ("[rad/s]",) * 3
+        self.coordinate_names = [f"{n}.{c} {u}" for n in self.body_names for c, u in zip(qn, qu)] + self.extra_names
+        self.velocity_names = [f"{n}.{c} {u}" for n in self.body_names for c, u in zip(vn, vu)] + [f"{n}.rate" for n in self.extra_names]
+        # mass matrix --------------------------------------------------------------------------
+        blocks = []
+        for body in bodies:
+            if sp_.dim == 2:
+                blocks.append(np.diag([body.mass, body.mass, body.inertia]))
+            else:
+                blk = np.zeros((6, 6))
+                blk[:3, :3] = body.mass * np.eye(3)
+                blk[3:, 3:] = body.inertia
+                blocks.append(blk)
+        blocks += [np.array([[ex.mass]]) for ex in b.extras.values()]
+        self._M = sp.block_diag(blocks, format="csr") if blocks else sp.csr_matrix((0, 0))
+        self.mass_is_constant = True
+        self._masses = np.array([bd.mass for bd in bodies])
+        self._J = np.array([bd.inertia for bd in bodies]) if sp_.dim == 3 else None
+        # constant gravity force --------------------------------------------------------------
+        Qg = np.zeros((nb, sp_.n_v))
+        Qg[:, : sp_.dim] = self._masses[:, None] * self.gravity
+        self._Qg = np.concatenate([Qg.ravel(), np.zeros(ne)])
+        # compile joints ------------------------------------------------------------------------
+        bs0 = BodyStates.from_coordinates(sp_, nb, q0, v0)
+        ctx = BuildContext(sp_, self.body_names, bs0)
+        self._ctx_names = self.body_names
+        groups: OrderedDict[type, list] = OrderedDict()
+        self.joints = tuple(b.joints.values())
+        self.user_constraints: list[UserConstraint] = []
+        joint_of_label: dict[str, str] = {}
+        for j in self.joints:
+            if isinstance(j, UserConstraint):
+                self.user_constraints.append(j)
+                continue
+            for spec in j.primitives(ctx):
+                groups.setdefault(spec.kind, []).append(spec)
+                joint_of_label[spec.label] = j.name
+        self.kinds: list[PrimitiveKind] = []
+        for kind, specs in groups.items():
+            params: dict[str, list] = {}
+            for s in specs:
+                for k, v in s.params.items():
+                    params.setdefault(k, []).append(v)
+            kw = {}
+            for k, v in params.items():
+                if k == "dim":
+                    kw[k] = v[0]
+                elif k == "functions":
+                    kw[k] = v
+                else:
+                    kw[k] = np.array(v)
+            obj = kind(labels=[s.label for s in specs], **kw)
+            # ground index fix-up for drivers that use -1 for "no second body"
+            obj.bj = np.where(obj.bj < 0, nb, obj.bj)
+            self.kinds.append(obj)
+        # rows, names and the fixed sparse pattern of Φ_q ---------------------------------------
+        names, rows_of_joint = [], OrderedDict((j.name, []) for j in self.joints)
+        coo_r, coo_c, coo_mask = [], [], []
+        row = 0
+        nvb = sp_.n_v
+        self._kind_rows = []
+        for kind in self.kinds:
+            n, r = kind.n, kind.rows
+            self._kind_rows.append(slice(row, row + n * r))
+            rr = row + np.arange(n * r).reshape(n, r)
+            for e in range(n):
+                for k in range(r):
+                    names.append(f"{kind.labels[e]}[{k}]" if r > 1 else kind.labels[e])
+                rows_of_joint[joint_of_label[kind.labels[e]]].extend(rr[e].tolist())
+            bodies2 = np.stack([kind.bi, kind.bj], 1)  # (n, 2)
+            R = np.broadcast_to(rr[:, :, None, None], (n, r, 2, nvb))
+            Cc = np.broadcast_to((bodies2[:, None, :, None] * nvb + np.arange(nvb)), (n, r, 2, nvb))
+            M_ = np.broadcast_to((bodies2[:, None, :, None] < nb), (n, r, 2, nvb))
+            coo_r.append(R.ravel())
+            coo_c.append(Cc.ravel())
+            coo_mask.append(M_.ravel())
+            row += n * r
+        self._user_rows = []
+        for uc in self.user_constraints:
+            qi, vi = [], []
+            for bname in uc.bodies:
+                k = ctx.index(bname, uc.name)
+                if k == nb:
+                    continue
+                qi += list(range(k * sp_.n_q, (k + 1) * sp_.n_q))
+                vi += list(range(k * nvb, (k + 1) * nvb))
+            for cname in uc.coordinates:
+                if cname not in self.extra_names:
+                    raise ModelError(f"constraint {uc.name!r} refers to unknown coordinate {cname!r}")
+                e = self.extra_names.index(cname)
+                qi.append(nb * sp_.n_q + e)
+                vi.append(nb * nvb + e)
+            uc.bind(qi, vi, sp_)
+            self._user_rows.append(slice(row, row + uc.rows))
+            rr = np.arange(row, row + uc.rows)
+            names += [f"{uc.name}[{k}]" for k in range(uc.rows)]
+            rows_of_joint[uc.name].extend(rr.tolist())
+            coo_r.append(np.repeat(rr, len(vi)))
+            coo_c.append(np.tile(np.asarray(vi), uc.rows))
+            coo_mask.append(np.ones(uc.rows * len(vi), bool))
+            row += uc.rows
+        self.n_c = row
+        self.constraint_names = names
+        self._rows_of_joint = {k: np.asarray(v, np.int64) for k, v in rows_of_joint.items()}
+        self._active_rows = None  # set when redundant rows are removed
+        if coo_r:
+            r_all, c_all, m_all = np.concatenate(coo_r), np.concatenate(coo_c), np.concatenate(coo_mask)
+        else:
+            r_all = c_all = np.zeros(0, np.int64)
+            m_all = np.zeros(0, bool)
+        self._jac_mask = m_all
+        r_k, c_k = r_all[m_all], c_all[m_all]
+        order = np.lexsort((c_k, r_k))
+        self._jac_order = order
+        self._jac_indices = c_k[order].astype(np.int32)
+        self._jac_indptr = np.concatenate([[0], np.cumsum(np.bincount(r_k, minlength=self.n_c))]).astype(np.int32)
+        self._n_kind_entries = int(np.sum([k.n * k.rows * 2 * nvb for k in self.kinds]))
+        # forces ---------------------------------------------------------------------------------
+        fgroups: OrderedDict[type, list] = OrderedDict()
+        for f in b.forces.values():
+            fgroups.setdefault(type(f), []).append(f)
+        self.force_elements = tuple(b.forces.values())
+        self.force_kinds: list[ForceKind] = [cls_.compile(els, ctx) for cls_, els in fgroups.items()]
+        self.time_dependent = any(k.time_dependent for k in self.kinds)
+        self.is_conservative = all(fk.conservative for fk in self.force_kinds) and not self.time_dependent
+        self._reaction_points = {}
+        for j in self.joints:
+            if isinstance(j, UserConstraint):
+                continue
+            bj_name = j.body_j if j.body_j != GROUND else j.body_i
+            kb = ctx.index(bj_name, j.name)
+            self._reaction_points[j.name] = (kb, ctx.local_point(kb, j.report_point(ctx)))
+        return self
+
+    # --- picklability is automatic (plain attributes; time functions must be picklable) --------
+
+    # --- kinematics -------------------------------------------------------------------------
+    def body_states(self, q: Array, v: Array | None = None) -> BodyStates:
+        return BodyStates.from_coordinates(self.space, self.n_bodies, q, v)
+
+    def body_index(self, name: str) -> int:
+        if name == GROUND:
+            return self.n_bodies
+        try:
+            return self.body_names.index(name)
+        except ValueError:
+            raise ModelError(f"model {self.name!r} has no body {name!r}") from None
+
+    def q_slice(self, body: str) -> slice:
+        k = self.body_index(body)
+        return slice(k * self.space.n_q, (k + 1) * self.space.n_q)
+
+    def v_slice(self, body: str) -> slice:
+        k = self.body_index(body)
+        return slice(k * self.space.n_v, (k + 1) * self.space.n_v)
+
+    def qdot(self, q: Array, v: Array) -> Array:
+        if self.space.dim == 2:
+            return v.copy()
+        nb = self.n_bodies
+        out = np.empty(self.n_q)
+        qb = q[: nb * 7].reshape(nb, 7)
+        vb = v[: nb * 6].reshape(nb, 6)
+        ob = out[: nb * 7].reshape(nb, 7)
+        ob[:, :3] = vb[:, :3]
+        ob[:, 3:] = 0.5 * np.einsum("nij,ni->nj", frames.euler_rate_matrix(qb[:, 3:]), vb[:, 3:])
+        out[nb * 7 :] = v[nb * 6 :]
+        return out
+
+    def Z(self, q: Array):
+        if self.space.dim == 2:
+            return sp.identity(self.n_q, format="csr")
+        nb = self.n_bodies
+        L = frames.euler_rate_matrix(q[: nb * 7].reshape(nb, 7)[:, 3:])
+        blocks = []
+        for k in range(nb):
+            blk = np.zeros((7, 6))
+            blk[:3, :3] = np.eye(3)
+            blk[3:, 3:] = 0.5 * L[k].T
+            blocks.append(blk)
+        blocks += [np.eye(1)] * len(self.extra_names)
+        return sp.block_diag(blocks, format="csr")
+
+    def retract(self, q: Array, dv: Array) -> Array:
+        if self.space.dim == 2:
+            return q + dv
+        nb = self.n_bodies
+        out = q.copy()
+        qb = out[: nb * 7].reshape(nb, 7)
+        db = dv[: nb * 6].reshape(nb, 6)
+        qb[:, :3] += db[:, :3]
+        qb[:, 3:] = frames.quat_multiply(qb[:, 3:], frames.rotation_vector_to_euler(db[:, 3:]))
+        out[nb * 7 :] += dv[nb * 6 :]
+        return out
+
+    def normalize(self, q: Array) -> Array:
+        if self.space.dim == 2:
+            return q
+        nb = self.n_bodies
+        out = q.copy()
+        p = out[: nb * 7].reshape(nb, 7)[:, 3:]
+        p /= np.linalg.norm(p, axis=1, keepdims=True)
+        return out
+
+    def invariant_violation(self, q: Array) -> float:
+        if self.space.dim == 2 or self.n_bodies == 0:
+            return 0.0
+        p = q[: self.n_bodies * 7].reshape(self.n_bodies, 7)[:, 3:]
+        return float(np.max(np.abs(np.sum(p * p, 1) - 1.0)))
+
+    # --- dynamics ----------------------------------------------------------------------------
+    def M(self, t: float, q: Array):
+        return self._M
+
+    def _force_accumulate(self, bs: BodyStates, t: float) -> Array:
+        nb, nvb = self.n_bodies, self.space.n_v
+        acc = np.zeros((nb + 1, nvb))
+        for fk in self.force_kinds:
+            ev = fk.evaluate(bs, t)
+            np.add.at(acc, ev.bodies, ev.Qb)
+        return acc[:nb]
+
+    def Q(self, t: float, q: Array, v: Array) -> Array:
+        Q = self._Qg.copy()
+        nb, nvb = self.n_bodies, self.space.n_v
+        if self.space.dim == 3 and nb:
+            w = v[: nb * 6].reshape(nb, 6)[:, 3:]
+            Jw = np.einsum("nij,nj->ni", self._J, w)
+            Q[: nb * 6].reshape(nb, 6)[:, 3:] -= np.cross(w, Jw)
+        if self.force_kinds:
+            bs = self.body_states(q, v)
+            Q[: nb * nvb] += self._force_accumulate(bs, t).ravel()
+        return Q
+
+    def _force_jacobians(self, t, q, v):
+        """Sparse (Q_q, Q_v) from analytic kind Jacobians; None if any kind lacks one."""
+        nvb, nb = self.space.n_v, self.n_bodies
+        bs = self.body_states(q, v)
+        rows, cols, Kq, Kv = [], [], [], []
+        for fk in self.force_kinds:
+            jac: ForceJacobian | None = fk.jacobian(bs, t)
+            if jac is None:
+                return None
+            rows.append(jac.rows)
+            cols.append(jac.cols)
+            Kq.append(jac.Kq)
+            Kv.append(jac.Kv)
+        if self.space.dim == 3 and nb:
+            w = v[: nb * 6].reshape(nb, 6)[:, 3:]
+            Jw = np.einsum("nij,nj->ni", self._J, w)
+            G = np.zeros((nb, 6, 6))
+            G[:, 3:, 3:] = -(np.einsum("nij,njk->nik", frames.skew(w), self._J) - frames.skew(Jw))
+            idx = np.arange(nb)
+            rows.append(idx)
+            cols.append(idx)
+            Kq.append(np.zeros((nb, 6, 6)))
+            Kv.append(G)
+        if not rows:
+            Z = sp.csr_matrix((self.n_v, self.n_v))
+            return Z, Z
+        r = np.concatenate(rows)
+        c = np.concatenate(cols)
+        keep = (r < nb) & (c < nb)
+        r, c = r[keep], c[keep]
+        I = (r[:, None, None] * nvb + np.arange(nvb)[None, :, None]) + 0 * np.arange(nvb)[None, None, :]
+        Jc = (c[:, None, None] * nvb + np.arange(nvb)[None, None, :]) + 0 * np.arange(nvb)[None, :, None]
+        shape = (self.n_v, self.n_v)
+        Qq = sp.csr_matrix((np.concatenate(Kq)[keep].ravel(), (I.ravel(), Jc.ravel())), shape=shape)
+        Qv = sp.csr_matrix((np.concatenate(Kv)[keep].ravel(), (I.ravel(), Jc.ravel())), shape=shape)
+        return Qq, Qv
+
+    def Q_q(self, t, q, v):
+        jj = self._force_jacobians(t, q, v)
+        return super().Q_q(t, q, v) if jj is None else jj[0]
+
+    def Q_v(self, t, q, v):
+        jj = self._force_jacobians(t, q, v)
+        return super().Q_v(t, q, v) if jj is None else jj[1]
+
+    def Q_jacobians(self, t, q, v):
+        """Both ``(Q_q, Q_v)`` in one pass (sparse when analytic)."""
+        jj = self._force_jacobians(t, q, v)
+        if jj is None:
+            return super().Q_q(t, q, v), super().Q_v(t, q, v)
+        return jj
+
+    # --- constraints -------------------------------------------------------------------------
+    def _eval_kinds(self, t, q, v, what):
+        bs = self.body_states(q, v)
+        return [k.evaluate(bs, t, what) for k in self.kinds]
+
+    def _select(self, full: Array) -> Array:
+        return full if self._active_rows is None else full[self._active_rows]
+
+    def _Phi_all(self, t, q):
+        parts = [e.phi.ravel() for e in self._eval_kinds(t, q, None, "p")]
+        parts += [np.asarray(uc.phi(t, q), float).ravel() for uc in self.user_constraints]
+        return np.concatenate(parts) if parts else np.zeros(0)
+
+    def Phi(self, t: float, q: Array) -> Array:
+        return self._select(self._Phi_all(t, q))
+
+    def _Phi_q_all(self, t, q):
+        parts = [e.jac.ravel() for e in self._eval_kinds(t, q, None, "j")]
+        parts += [np.asarray(uc.jacobian(t, q), float).ravel() for uc in self.user_constraints]
+        data = np.concatenate(parts) if parts else np.zeros(0)
+        n_kind = self._n_kind_entries
+        kd = data[:n_kind][self._jac_mask[:n_kind]]
+        data = np.concatenate([kd, data[n_kind:]])[self._jac_order]
+        return sp.csr_matrix((data, self._jac_indices, self._jac_indptr), shape=(self._n_c_all, self.n_v))
+
+    @property
+    def _n_c_all(self):
+        return len(self._jac_indptr) - 1
+
+    def Phi_q(self, t: float, q: Array):
+        J = self._Phi_q_all(t, q)
+        return J if self._active_rows is None else J[self._active_rows]
+
+    def nu(self, t: float, q: Array) -> Array:
+        if not self.time_dependent and not self.user_constraints:
+            return np.zeros(self.n_c)
+        parts = [e.nu.ravel() for e in self._eval_kinds(t, q, None, "n")]
+        parts += [np.asarray(uc.nu(t, q), float).ravel() for uc in self.user_constraints]
+        return self._select(np.concatenate(parts) if parts else np.zeros(0))
+
+    def gamma(self, t: float, q: Array, v: Array) -> Array:
+        parts = [e.gamma.ravel() for e in self._eval_kinds(t, q, v, "g")]
+        parts += [np.asarray(uc.gamma(t, q, v), float).ravel() for uc in self.user_constraints]
+        return self._select(np.concatenate(parts) if parts else np.zeros(0))
+
+    def constraint_terms(self, t: float, q: Array, v: Array):
+        """``(Φ, Φ_q, ν, γ)`` in a single pass over the element kinds (used by integrators)."""
+        bs = self.body_states(q, v)
+        ev = [k.evaluate(bs, t, "pjng") for k in self.kinds]
+        phi = [e.phi.ravel() for e in ev] + [np.asarray(uc.phi(t, q), float).ravel() for uc in self.user_constraints]
+        nu = [e.nu.ravel() for e in ev] + [np.asarray(uc.nu(t, q), float).ravel() for uc in self.user_constraints]
+        ga = [e.gamma.ravel() for e in ev] + [np.asarray(uc.gamma(t, q, v), float).ravel() for uc in self.user_constraints]
+        jd = [e.jac.ravel() for e in ev] + [np.asarray(uc.jacobian(t, q), float).ravel() for uc in self.user_constraints]
+        cat = lambda xs: np.concatenate(xs) if xs else np.zeros(0)  # noqa: E731
+        data = cat(jd)
+        n_kind = self._n_kind_entries
+        data = np.concatenate([data[:n_kind][self._jac_mask[:n_kind]], data[n_kind:]])[self._jac_order]
+        J = sp.csr_matrix((data, self._jac_indices, self._jac_indptr), shape=(self._n_c_all, self.n_v))
+        if self._active_rows is not None:
+            J = J[self._active_rows]
+        return self._select(cat(phi)), J, self._select(cat(nu)), self._select(cat(ga))
+
+    # --- energy and reactions ------------------------------------------------------------------
+    def energy(self, t: float, q: Array, v: Array) -> float:
+        T = 0.5 * float(v @ (self._M @ v))
+        nb = self.n_bodies
+        r = q[: nb * self.space.n_q].reshape(nb, self.space.n_q)[:, : self.space.dim]
+        V = -float(np.sum(self._masses * (r @ self.gravity)))
+        if self.force_kinds:
+            bs = self.body_states(q, v)
+            V += sum(fk.potential(bs) for fk in self.force_kinds)
+        return T + V
+
+    def reaction_groups(self) -> dict[str, NDArray[np.int64]]:
+        if self._active_rows is None:
+            return dict(self._rows_of_joint)
+        pos = {int(r): k for k, r in enumerate(self._active_rows)}
+        return {n: np.array([pos[int(r)] for r in rows if int(r) in pos], np.int64) for n, rows in self._rows_of_joint.items()}
+
+    def reaction_names(self) -> dict[str, list[str]]:
+        if self.space.dim == 2:
+            cols = ["Fx [N]", "Fy [N]", "Mz [N m]"]
+        else:
+            cols = ["Fx [N]", "Fy [N]", "Fz [N]", "Mx [N m]", "My [N m]", "Mz [N m]"]
+        return {n: cols for n in self._reaction_points}
+
+    def reactions(self, t: float, q: Array, lam: Array) -> dict[str, Array]:
+        r"""Joint reactions on the reporting body at the joint point, global axes.
+
+        The constraint force on body ``b`` is ``Q^c_b = −(Φ_q)_{rows,b}ᵀ λ_rows``: a force at the
+        body origin plus a moment (planar scalar / spatial body-frame).  Transferred to the joint
+        point P: ``M_P = M_cm − (r_P − r_cm) × F``.
+        """
+        J = self.Phi_q(t, q)
+        groups = self.reaction_groups()
+        bs = self.body_states(q, None)
+        d, nvb = self.space.dim, self.space.n_v
+        out = {}
+        for name, (kb, sloc) in self._reaction_points.items():
+            rows = groups.get(name)
+            if rows is None or len(rows) == 0 or kb >= self.n_bodies:
+                continue
+            cols = slice(kb * nvb, (kb + 1) * nvb)
+            Qc = -(J[rows][:, cols].T @ lam[rows])
+            Qc = np.asarray(Qc).ravel()
+            F = Qc[:d]
+            arm = bs.A[kb] @ sloc
+            if d == 2:
+                Mcm = Qc[2]
+                Mp = Mcm - (arm[0] * F[1] - arm[1] * F[0])
+                out[name] = np.array([F[0], F[1], Mp])
+            else:
+                Mcm = bs.A[kb] @ Qc[3:]
+                Mp = Mcm - np.cross(arm, F)
+                out[name] = np.concatenate([F, Mp])
+        return out
+
+    # --- build-time checks -------------------------------------------------------------------
+    def _check_initial(self, tol: float) -> None:
+        if self.n_c == 0:
+            return
+        phi = self.Phi(0.0, self.q0)
+        if not np.all(np.isfinite(phi)):
+            k = int(np.flatnonzero(~np.isfinite(phi))[0])
+            raise ModelError(f"model {self.name!r}: constraint {self.constraint_names[k]!r} is not finite at the initial configuration")
+        scale = max(1.0, float(np.max(np.abs(self.q0))) if self.n_q else 1.0)
+        bad = np.flatnonzero(np.abs(phi) > tol * scale)
+        if len(bad):
+            worst = bad[np.argmax(np.abs(phi[bad]))]
+            raise ModelError(
+                f"model {self.name!r}: inconsistent initial positions; constraint {self.constraint_names[worst]!r} "
+                f"is violated by {phi[worst]:.3e} ({len(bad)} rows over tolerance {tol:g}). "
+                "Fix the initial configuration or build(assemble=True)."
+            )
+        vv = self.velocity_violation(0.0, self.q0, self.v0)
+        bad = np.flatnonzero(np.abs(vv) > tol * max(1.0, float(np.max(np.abs(self.v0))) if self.n_v else 1.0))
+        if len(bad):
+            worst = bad[np.argmax(np.abs(vv[bad]))]
+            raise ModelError(
+                f"model {self.name!r}: inconsistent initial velocities; constraint {self.constraint_names[worst]!r} "
+                f"has velocity residual {vv[worst]:.3e}. Fix the initial velocities or build(assemble=True)."
+            )
+
+    def dependent_constraints(self, q: Array | None = None, tol: float = 1e-9) -> list[int]:
+        """Indices of constraint rows that are linear combinations of earlier-pivoted rows.
+
+        Rank-revealing QR with column pivoting of ``Φ_qᵀ`` (Businger & Golub 1965): the first
+        ``rank`` pivots are an independent row set; the others are dependent.
+        """
+        if self.n_c == 0:
+            return []
+        J = self._Phi_q_all(0.0, self.q0 if q is None else q).toarray()
+        Rm, piv = sla.qr(J.T, mode="r", pivoting=True)
+        diag = np.abs(np.diag(Rm)) if Rm.size else np.zeros(0)
+        smax = diag[0] if len(diag) else 0.0
+        rank = int(np.sum(diag > tol * max(1.0, smax) * max(J.shape)))
+        return sorted(int(i) for i in piv[rank:])
+
+    def _check_redundancy(self, mode: str, tol: float) -> None:
+        dep = self.dependent_constraints(tol=tol)
+        self.redundant_constraints = [self.constraint_names[i] for i in dep]
+        self.redundant_rows = np.asarray(dep, np.int64)
+        if not dep:
+            return
+        msg = (
+            f"model {self.name!r}: {len(dep)} redundant constraint equation(s) at the initial configuration: "
+            + ", ".join(self.redundant_constraints)
+        )
+        if mode == "raise":
+            raise RedundantConstraintError(msg + ". Use build(redundant='remove') or 'keep'.", self.redundant_constraints)
+        if mode == "remove":
+            warnings.warn(msg + " (removed)", stacklevel=3)
+            keep = np.setdiff1d(np.arange(self._n_c_all), dep)
+            self._active_rows = keep
+            self.n_c = len(keep)
+            self.constraint_names = [self.constraint_names[i] for i in keep]
+        else:
+            warnings.warn(msg + " (kept; multipliers are minimum-norm)", stacklevel=3)
+
+    @property
+    def degrees_of_freedom(self) -> int:
+        """``n_v − rank(Φ_q)`` at the initial configuration."""
+        return self.n_v - (self.n_c - len(getattr(self, "redundant_rows", [])) if self._active_rows is None else self.n_c)
+
+    def with_state(self, q0: Array, v0: Array) -> Model:
+        """A copy of the model with another initial state (used by assembly)."""
+        import copy
+
+        m = copy.copy(self)
+        m.q0 = np.asarray(q0, float).copy()
+        m.v0 = np.asarray(v0, float).copy()
+        return m

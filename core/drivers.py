@@ -41,6 +41,59 @@ class TimeFunction:
         return f"TimeFunction({self.label})"
 
 
+# Module-level callables instead of lambdas/closures, so that TimeFunctions -- and with them
+# models holding drivers and actuators -- can be pickled (process-pool sweeps).
+
+
+class _CentralDifference:
+    """First (order 1) or second (order 2) central difference of f with h = 1e-4·max(1, |t|)."""
+
+    def __init__(self, f: Callable[[float], float], order: int):
+        self.f, self.order = f, order
+
+    def __call__(self, t):
+        h = 1e-4 * max(1.0, abs(t))
+        if self.order == 1:
+            return (self.f(t + h) - self.f(t - h)) / (2 * h)
+        return (self.f(t + h) - 2 * self.f(t) + self.f(t - h)) / (h * h)
+
+
+class _Constant:
+    def __init__(self, value: float):
+        self.value = value
+
+    def __call__(self, t):
+        return self.value
+
+
+class _Harmonic:
+    """Derivative ``order`` of offset + amplitude·sin(ωt + phase)."""
+
+    def __init__(self, amplitude, omega, phase, offset, order):
+        self.a, self.w, self.ph, self.off, self.order = amplitude, omega, phase, offset, order
+
+    def __call__(self, t):
+        x = self.w * t + self.ph
+        if self.order == 0:
+            return self.off + self.a * np.sin(x)
+        if self.order == 1:
+            return self.a * self.w * np.cos(x)
+        return -self.a * self.w**2 * np.sin(x)
+
+
+class _RangeGuard:
+    """Evaluate ``fn`` after checking t against the tabulated range (unless extrapolating)."""
+
+    def __init__(self, fn, lo, hi, label, extrapolate):
+        self.fn, self.lo, self.hi, self.label, self.extrapolate = fn, lo, hi, label, extrapolate
+
+    def __call__(self, tt):
+        lo, hi = self.lo, self.hi
+        if not self.extrapolate and (tt < lo - 1e-12 * max(1, abs(lo)) or tt > hi + 1e-12 * max(1, abs(hi))):
+            raise ValueError(f"table {self.label!r}: time {tt} outside the tabulated range [{lo}, {hi}]")
+        return self.fn(tt)
+
+
 def motion(f: Callable[[float], float], fd: Callable[[float], float] | None = None,
            fdd: Callable[[float], float] | None = None, label: str = "f(t)") -> TimeFunction:
     """Wrap a callable as a :class:`TimeFunction`.
@@ -52,23 +105,16 @@ def motion(f: Callable[[float], float], fd: Callable[[float], float] | None = No
     if not callable(f):
         raise TypeError(f"motion {label!r}: f must be callable, got {type(f).__name__}")
 
-    def _h(t):
-        return 1e-4 * max(1.0, abs(t))
-
     if fd is None:
-        def fd(t):  # noqa: E306
-            h = _h(t)
-            return (f(t + h) - f(t - h)) / (2 * h)
+        fd = _CentralDifference(f, 1)
     if fdd is None:
-        def fdd(t):  # noqa: E306
-            h = _h(t)
-            return (f(t + h) - 2 * f(t) + f(t - h)) / (h * h)
+        fdd = _CentralDifference(f, 2)
     return TimeFunction(f, fd, fdd, label)
 
 
 def constant(value: float) -> TimeFunction:
     """f(t) = value."""
-    return TimeFunction(lambda t: value, lambda t: 0.0, lambda t: 0.0, f"{value}")
+    return TimeFunction(_Constant(value), _Constant(0.0), _Constant(0.0), f"{value}")
 
 
 def polynomial(coefficients) -> TimeFunction:
@@ -86,9 +132,9 @@ def ramp(rate: float, start: float = 0.0) -> TimeFunction:
 def harmonic(amplitude: float, omega: float, phase: float = 0.0, offset: float = 0.0) -> TimeFunction:
     """f(t) = offset + amplitude·sin(ωt + phase)."""
     return TimeFunction(
-        lambda t: offset + amplitude * np.sin(omega * t + phase),
-        lambda t: amplitude * omega * np.cos(omega * t + phase),
-        lambda t: -amplitude * omega**2 * np.sin(omega * t + phase),
+        _Harmonic(amplitude, omega, phase, offset, 0),
+        _Harmonic(amplitude, omega, phase, offset, 1),
+        _Harmonic(amplitude, omega, phase, offset, 2),
         f"{amplitude}·sin({omega}t+{phase})",
     )
 
@@ -122,14 +168,7 @@ def tabulated(times, values, label: str = "table", bc_type: str = "not-a-knot",
     d1, d2 = cs.derivative(1), cs.derivative(2)
     lo, hi = t[0], t[-1]
 
-    def guard(fn):
-        def g(tt):
-            if not extrapolate and (tt < lo - 1e-12 * max(1, abs(lo)) or tt > hi + 1e-12 * max(1, abs(hi))):
-                raise ValueError(f"table {label!r}: time {tt} outside the tabulated range [{lo}, {hi}]")
-            return fn(tt)
-        return g
-
-    return TimeFunction(guard(cs), guard(d1), guard(d2), label)
+    return TimeFunction(*(_RangeGuard(fn, lo, hi, label, extrapolate) for fn in (cs, d1, d2)), label)
 
 
 def as_time_function(obj, label: str = "f(t)") -> TimeFunction:

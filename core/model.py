@@ -156,14 +156,16 @@ class ModelBuilder:
         if not (np.isfinite(mass) and mass >= 0):
             raise ModelError(f"body {name!r}: mass must be ≥ 0, got {mass}")
         vel = np.zeros(d) if velocity is None else np.asarray(velocity, float)
-        if vel.shape != (d,):
-            raise ModelError(f"body {name!r}: velocity must have {d} components")
+        if vel.shape != (d,) or not np.all(np.isfinite(vel)):
+            raise ModelError(f"body {name!r}: velocity must be {d} finite numbers")
         if d == 2:
             J = float(inertia)
             if not (np.isfinite(J) and J >= 0):
                 raise ModelError(f"body {name!r}: polar moment of inertia must be ≥ 0, got {inertia}")
             ori = 0.0 if orientation is None else float(orientation)
             om = 0.0 if angular_velocity is None else float(angular_velocity)
+            if not (np.isfinite(ori) and np.isfinite(om)):
+                raise ModelError(f"body {name!r}: orientation and angular velocity must be finite, got {ori}, {om}")
             body = Body(name, float(mass), J, pos, ori, vel, om)
         else:
             J = np.asarray(inertia, float)
@@ -172,11 +174,11 @@ class ModelBuilder:
             if J.shape != (3, 3) or not np.allclose(J, J.T) or np.any(np.linalg.eigvalsh(J) < -1e-15):
                 raise ModelError(f"body {name!r}: inertia must be a symmetric positive semi-definite 3×3 tensor (or 3 principal moments)")
             p = np.array([1.0, 0, 0, 0]) if orientation is None else np.asarray(orientation, float)
-            if p.shape != (4,) or abs(np.linalg.norm(p) - 1.0) > 1e-6:
+            if p.shape != (4,) or not abs(np.linalg.norm(p) - 1.0) <= 1e-6:  # `not <=` also rejects NaN
                 raise ModelError(f"body {name!r}: orientation must be 4 Euler parameters of unit norm, got {np.asarray(orientation).tolist()}")
             om = np.zeros(3) if angular_velocity is None else np.asarray(angular_velocity, float)
-            if om.shape != (3,):
-                raise ModelError(f"body {name!r}: angular velocity must have 3 components")
+            if om.shape != (3,) or not np.all(np.isfinite(om)):
+                raise ModelError(f"body {name!r}: angular velocity must be 3 finite numbers")
             body = Body(name, float(mass), J, pos, p / np.linalg.norm(p), vel, om)
         self.bodies[name] = body
         return name
@@ -242,6 +244,49 @@ class ModelBuilder:
         from .forces import SpringDamper
 
         return self.add_force(SpringDamper(name, body_i, body_j, point_i, point_j, stiffness, damping, free_length, actuator))
+
+    def add_point_spring(self, name, body_i, body_j, point_i, point_j=None, stiffness=0.0, damping=0.0):
+        """Zero-free-length point-to-point spring-damper (:class:`core.forces.PointSpring`)."""
+        from .forces import PointSpring
+
+        return self.add_force(PointSpring(name, body_i, body_j, point_i, point_j, stiffness, damping))
+
+    def add_rotational_spring_damper(self, name, body_i, body_j, stiffness, damping=0.0, free_angle=0.0,
+                                     actuator=None, axis=None):
+        """Torsional spring-damper-actuator (:class:`core.forces.RotationalSpringDamper`); spatial needs ``axis``."""
+        from .forces import RotationalSpringDamper
+
+        return self.add_force(RotationalSpringDamper(name, body_i, body_j, stiffness, damping, free_angle, actuator, axis))
+
+    def add_bushing(self, name, body_i, body_j, at, translational_stiffness, rotational_stiffness,
+                    translational_damping=0.0, rotational_damping=0.0, axes=None, point_j=None):
+        """Linear bushing between marker frames at ``at`` (:class:`core.forces.Bushing`)."""
+        from .forces import Bushing
+
+        return self.add_force(Bushing(name, body_i, body_j, at, translational_stiffness, rotational_stiffness,
+                                      translational_damping, rotational_damping, axes, point_j))
+
+    def add_applied_force(self, name, body, point, force, frame="global"):
+        """Force of time at a body point (:class:`core.forces.AppliedForce`)."""
+        from .forces import AppliedForce
+
+        return self.add_force(AppliedForce(name, body, point, force, frame))
+
+    def add_applied_torque(self, name, body, torque, frame="global"):
+        """Torque of time on a body (:class:`core.forces.AppliedTorque`)."""
+        from .forces import AppliedTorque
+
+        return self.add_force(AppliedTorque(name, body, torque, frame))
+
+    def add_plane_contact(self, name, body, center, radius, plane_point, plane_normal, restitution=1.0,
+                          impact_velocity=None, stiffness=None, exponent=1.5, materials=None, friction=0.0,
+                          friction_velocity=1e-3, model="lankarani-nikravesh"):
+        """Sphere-on-ground-plane continuous contact (:class:`core.forces.PlaneContact`)."""
+        from .forces import PlaneContact
+
+        return self.add_force(PlaneContact(name, body, center, radius, plane_point, plane_normal, restitution,
+                                           impact_velocity, stiffness, exponent, materials, friction,
+                                           friction_velocity, model))
 
     # --- build ------------------------------------------------------------------------------
     def build(self, assemble: bool = False, redundant: str = "raise", tol: float = 1e-9) -> Model:

@@ -1,0 +1,37 @@
+# Two commands: `make run` writes every scene's tables and figures into out/;
+# `make test` runs the test-suite. Both create the virtual environment $(VENV) and
+# install mbsuite into it in editable mode (again whenever pyproject.toml changes).
+
+PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
+VENV   ?= .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.mbsuite-installed
+OUT    ?= out
+
+export MPLBACKEND := Agg
+
+.PHONY: run test bench clean
+
+run: $(STAMP)
+	$(BIN)/mbsuite run --all -o $(OUT)/
+
+test: $(STAMP)
+	$(BIN)/python -m pytest -q
+
+bench: $(STAMP)
+	@if [ -f benchmarks/run_all.py ]; then \
+		$(BIN)/python benchmarks/run_all.py; \
+	else \
+		echo "benchmarks/run_all.py does not exist yet; run single benchmarks with $(BIN)/python benchmarks/<name>.py"; \
+	fi
+
+$(BIN)/python:
+	$(PYTHON) -c 'import sys; assert sys.version_info >= (3, 11), f"mbsuite needs Python >= 3.11, $(PYTHON) is {sys.version.split()[0]}"'
+	$(PYTHON) -m venv $(VENV)
+
+$(STAMP): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[test]'
+	touch $@
+
+clean:
+	rm -rf $(OUT) .pytest_cache .hypothesis build dist

@@ -1,0 +1,526 @@
+r"""Result containers and table writers.
+
+Every integrator run ends in a :class:`SimulationResult`: the sampled time history
+of the coordinates ``q``, velocities ``v`` and Lagrange multipliers ``lam``, the
+constraint violations at position and velocity level, the energy where the system
+is conservative, joint reactions, the final status and the run metadata. Its
+methods return pandas DataFrames with SI units in the column names, one row per
+output time, which :func:`write_table` writes as CSV (full precision, for
+spreadsheets and scripts) and Markdown (formatted, for reports).
+
+The violations are defined as
+
+.. math::
+
+    e_\Phi(t_k) = \lVert \Phi(t_k, q_k) \rVert_\infty, \qquad
+    e_\nu(t_k) = \lVert \Phi_q(t_k, q_k)\, v_k - \nu(t_k, q_k) \rVert_\infty ,
+
+and the energy drift as :math:`E(t_k) - E(t_0)`, made relative by
+:math:`|E(t_0)|` (or by :math:`\max_k |E(t_k)|` when :math:`E(t_0) = 0`).
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal, NamedTuple
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "FinalState",
+    "SimulationResult",
+    "environment_versions",
+    "run_metadata",
+    "write_table",
+]
+
+TIME_COLUMN = "t [s]"
+POSITION_VIOLATION_COLUMN = "position violation [m]"
+VELOCITY_VIOLATION_COLUMN = "velocity violation [m/s]"
+_VIOLATION_UNITS_NOTE = (
+    "Max-abs over all constraint equations. Rows of Phi that are angles (or "
+    "dimensionless, e.g. Euler-parameter normalisation) contribute in rad (rad/s) "
+    "or 1 (1/s); the [m] and [m/s] labels are nominal."
+)
+_STEM_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.\-]*$")
+
+
+# ----------------------------------------------------------------------------------
+# Table writers
+# ----------------------------------------------------------------------------------
+def _check_stem(stem: str) -> str:
+    if not isinstance(stem, str) or not _STEM_RE.match(stem) or stem.endswith("."):
+        raise ValueError(
+            f"table/figure stem {stem!r} must be a plain file name (letters, digits, '_', '-', '.')"
+        )
+    return stem
+
+
+def write_table(
+    df: pd.DataFrame, out_dir: str | Path, stem: str, floatfmt: str = ".6g"
+) -> dict[str, Path]:
+    """Write a DataFrame as ``<stem>.csv`` and ``<stem>.md`` into ``out_dir``.
+
+    The CSV keeps full floating-point precision (shortest repr, so ``pd.read_csv``
+    of pandas >= 3 reads back the identical floats; with pandas 2 pass
+    ``float_precision="round_trip"``); only the Markdown table is formatted with
+    ``floatfmt``. A default ``RangeIndex`` is not written; any other
+    index is written as the first column(s).
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        Table to write; units belong in the column names, e.g. ``"Fx [N]"``.
+    out_dir : str or Path
+        Output folder, created if missing.
+    stem : str
+        File name without suffix.
+    floatfmt : str, optional
+        Format spec for floats in the Markdown table (passed to tabulate).
+
+    Returns
+    -------
+    dict of str to Path
+        ``{"csv": path, "md": path}``.
+    """
+    if not isinstance(df, pd.DataFrame):
+        raise TypeError(f"write_table({stem!r}): expected a pandas DataFrame, got {type(df).__name__}")
+    _check_stem(stem)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    keep_index = not (isinstance(df.index, pd.RangeIndex) and df.index.name is None)
+    csv_path = out / f"{stem}.csv"
+    md_path = out / f"{stem}.md"
+    df.to_csv(csv_path, index=keep_index)
+    md_path.write_text(df.to_markdown(index=keep_index, floatfmt=floatfmt) + "\n", encoding="utf-8")
+    return {"csv": csv_path, "md": md_path}
+
+
+# ----------------------------------------------------------------------------------
+# Metadata helpers
+# ----------------------------------------------------------------------------------
+def environment_versions() -> dict[str, str]:
+    """Return the versions of mbsuite, Python, numpy, scipy and pandas.
+
+    Returns
+    -------
+    dict of str to str
+        Package name -> version; ``"unknown"`` for mbsuite when it is not installed.
+    """
+    import platform
+
+    import scipy
+
+    try:
+        mbsuite_version = importlib.metadata.version("mbsuite")
+    except importlib.metadata.PackageNotFoundError:
+        mbsuite_version = "unknown"
+    return {
+        "mbsuite": mbsuite_version,
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "pandas": pd.__version__,
+    }
+
+
+def run_metadata(
+    *,
+    method: str,
+    model_name: str = "",
+    rtol: float | None = None,
+    atol: float | None = None,
+    step_size: float | None = None,
+    wall_time_s: float | None = None,
+    **extra: Any,
+) -> dict[str, Any]:
+    """Build the ``meta`` dict of a :class:`SimulationResult`.
+
+    Parameters
+    ----------
+    method : str
+        Integrator / formulation name, e.g. ``"RK45+Baumgarte"``.
+    model_name : str, optional
+        Name of the simulated model.
+    rtol, atol : float, optional
+        Requested relative and absolute tolerances (None for fixed-step methods).
+    step_size : float, optional
+        Fixed or initial step size [s].
+    wall_time_s : float, optional
+        Wall-clock time of the run [s].
+    **extra
+        Further entries (e.g. Baumgarte parameters) stored verbatim.
+
+    Returns
+    -------
+    dict
+        Metadata including ``"versions"`` from :func:`environment_versions`.
+    """
+    meta: dict[str, Any] = {
+        "method": method,
+        "model": model_name,
+        "rtol": rtol,
+        "atol": atol,
+        "step size [s]": step_size,
+        "wall time [s]": wall_time_s,
+    }
+    meta.update(extra)
+    meta["versions"] = environment_versions()
+    return meta
+
+
+def _flatten(mapping: dict[str, Any], prefix: str = "") -> dict[str, Any]:
+    flat: dict[str, Any] = {}
+    for key, value in mapping.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            flat.update(_flatten(value, prefix=f"{name}."))
+        else:
+            flat[name] = value
+    return flat
+
+
+# ----------------------------------------------------------------------------------
+# SimulationResult
+# ----------------------------------------------------------------------------------
+class FinalState(NamedTuple):
+    """State at the last output time of a run (copies, safe to modify)."""
+
+    t: float
+    q: np.ndarray
+    v: np.ndarray
+    lam: np.ndarray | None
+
+
+def _readonly(name: str, value: Any, ndim: int) -> np.ndarray:
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"SimulationResult.{name} must be numeric: {exc}") from exc
+    if arr.ndim != ndim:
+        raise ValueError(f"SimulationResult.{name} must be {ndim}-D, got shape {arr.shape}")
+    view = arr.view()
+    view.flags.writeable = False
+    return view
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class SimulationResult:
+    r"""Time history and diagnostics of one integrator run.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n_t,)
+        Output times [s], strictly increasing.
+    q : ndarray, shape (n_t, n_q)
+        Generalized coordinates at the output times (m, rad, or 1 for Euler parameters).
+    v : ndarray, shape (n_t, n_v)
+        Generalized velocities (m/s, rad/s).
+    status : {"finished", "failed"}
+        Final status of the integrator.
+    message : str, optional
+        Human-readable reason for the status (where and why a failed run stopped).
+    lam : ndarray, shape (n_t, n_c), optional
+        Lagrange multipliers; None if the formulation does not produce them.
+    counters : dict of str to int, optional
+        Work counters: right-hand sides, Jacobians, factorizations, Newton iterations,
+        rejected steps, ...
+    meta : dict, optional
+        Run metadata (see :func:`run_metadata`): method, rtol, atol, step size, wall
+        time, model name, versions. ``"versions"`` is added if missing.
+    coordinate_names, velocity_names : list of str, optional
+        Column names for ``q`` and ``v``, ideally with units, e.g. ``"crank.x [m]"``.
+        Default ``"q[i]"`` / ``"v[i]"``.
+    constraint_names : list of str, optional
+        Names of the ``n_c`` constraint equations (columns of ``lam``). Default ``"lam[i]"``.
+    position_violation : ndarray, shape (n_t,)
+        :math:`\lVert\Phi(t, q)\rVert_\infty`. Required when ``n_c > 0``; zeros otherwise.
+    velocity_violation : ndarray, shape (n_t,)
+        :math:`\lVert\Phi_q v - \nu\rVert_\infty`. Required when ``n_c > 0``.
+    energy : ndarray, shape (n_t,), optional
+        Total mechanical energy [J] for conservative systems.
+    reactions : dict of str to ndarray of shape (n_t, k), optional
+        Joint reaction forces/torques per joint name.
+    reaction_names : dict of str to list of str, optional
+        Column names per joint, e.g. ``["Fx [N]", "Fy [N]", "Mz [N m]"]``.
+
+    Notes
+    -----
+    ``n_c`` is taken from ``lam`` if given, else from ``constraint_names``, else 0.
+    Arrays are stored as read-only views; the instance is immutable.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    status: Literal["finished", "failed"]
+    message: str = ""
+    lam: np.ndarray | None = None
+    counters: dict[str, int] = field(default_factory=dict)
+    meta: dict[str, Any] = field(default_factory=dict)
+    coordinate_names: list[str] | None = None
+    velocity_names: list[str] | None = None
+    constraint_names: list[str] | None = None
+    position_violation: np.ndarray | None = None
+    velocity_violation: np.ndarray | None = None
+    energy: np.ndarray | None = None
+    reactions: dict[str, np.ndarray] = field(default_factory=dict)
+    reaction_names: dict[str, list[str]] = field(default_factory=dict)
+
+    # -- validation ---------------------------------------------------------------
+    def __post_init__(self) -> None:  # noqa: C901 - one check per field, in order
+        put = object.__setattr__
+        if self.status not in ("finished", "failed"):
+            raise ValueError(f"SimulationResult.status must be 'finished' or 'failed', got {self.status!r}")
+        put(self, "message", str(self.message))
+
+        t = _readonly("t", self.t, 1)
+        n_t = t.shape[0]
+        if n_t == 0:
+            raise ValueError("SimulationResult.t is empty; a run records at least the initial time")
+        steps = np.diff(t)
+        bad = np.flatnonzero(~(steps > 0) & np.isfinite(steps))
+        if bad.size:
+            i = int(bad[0])
+            raise ValueError(
+                f"SimulationResult.t must be strictly increasing: t[{i}]={t[i]!r}, t[{i + 1}]={t[i + 1]!r}"
+            )
+        put(self, "t", t)
+
+        for name in ("q", "v"):
+            arr = _readonly(name, getattr(self, name), 2)
+            if arr.shape[0] != n_t:
+                raise ValueError(
+                    f"SimulationResult.{name} has {arr.shape[0]} rows but t has {n_t} samples "
+                    f"(expected shape ({n_t}, n_{name}))"
+                )
+            put(self, name, arr)
+
+        if self.lam is not None:
+            lam = _readonly("lam", self.lam, 2)
+            if lam.shape[0] != n_t:
+                raise ValueError(f"SimulationResult.lam has {lam.shape[0]} rows but t has {n_t} samples")
+            put(self, "lam", lam)
+            n_c = lam.shape[1]
+        else:
+            n_c = len(self.constraint_names) if self.constraint_names is not None else 0
+
+        self._set_names("coordinate_names", self.q.shape[1], "q")
+        self._set_names("velocity_names", self.v.shape[1], "v")
+        self._set_names("constraint_names", n_c, "lam")
+
+        for name in ("position_violation", "velocity_violation"):
+            value = getattr(self, name)
+            if value is None:
+                if n_c > 0:
+                    raise ValueError(
+                        f"SimulationResult.{name} is required for a system with {n_c} constraint equations"
+                    )
+                value = np.zeros(n_t)  # no constraints: violation is exactly zero
+            arr = _readonly(name, value, 1)
+            if arr.shape != (n_t,):
+                raise ValueError(f"SimulationResult.{name} has shape {arr.shape}, expected ({n_t},)")
+            put(self, name, arr)
+
+        if self.energy is not None:
+            energy = _readonly("energy", self.energy, 1)
+            if energy.shape != (n_t,):
+                raise ValueError(f"SimulationResult.energy has shape {energy.shape}, expected ({n_t},)")
+            put(self, "energy", energy)
+
+        counters: dict[str, int] = {}
+        for key, value in dict(self.counters).items():
+            if isinstance(value, bool) or int(value) != value or value < 0:
+                raise ValueError(f"SimulationResult.counters[{key!r}] must be a non-negative integer, got {value!r}")
+            counters[str(key)] = int(value)
+        put(self, "counters", counters)
+
+        meta = dict(self.meta)
+        meta.setdefault("versions", environment_versions())
+        put(self, "meta", meta)
+
+        reactions: dict[str, np.ndarray] = {}
+        reaction_names: dict[str, list[str]] = {}
+        unknown = set(self.reaction_names) - set(self.reactions)
+        if unknown:
+            raise ValueError(f"SimulationResult.reaction_names has joints without reactions: {sorted(unknown)}")
+        for joint, value in dict(self.reactions).items():
+            arr = _readonly(f"reactions[{joint!r}]", value, 2)
+            if arr.shape[0] != n_t:
+                raise ValueError(
+                    f"SimulationResult.reactions[{joint!r}] has {arr.shape[0]} rows but t has {n_t} samples"
+                )
+            names = self.reaction_names.get(joint)
+            names = [f"{joint}[{k}]" for k in range(arr.shape[1])] if names is None else list(names)
+            if len(names) != arr.shape[1]:
+                raise ValueError(
+                    f"SimulationResult.reaction_names[{joint!r}] has {len(names)} names "
+                    f"for {arr.shape[1]} reaction columns"
+                )
+            reactions[joint] = arr
+            reaction_names[joint] = names
+        put(self, "reactions", reactions)
+        put(self, "reaction_names", reaction_names)
+
+    def _set_names(self, attr: str, n: int, prefix: str) -> None:
+        names = getattr(self, attr)
+        names = [f"{prefix}[{i}]" for i in range(n)] if names is None else [str(s) for s in names]
+        if len(names) != n:
+            raise ValueError(f"SimulationResult.{attr} has {len(names)} names for {n} columns")
+        if len(set(names)) != n:
+            dupes = sorted({s for s in names if names.count(s) > 1})
+            raise ValueError(f"SimulationResult.{attr} has duplicate names: {dupes}")
+        object.__setattr__(self, attr, names)
+
+    # -- scalar properties ---------------------------------------------------------
+    @property
+    def success(self) -> bool:
+        """True if the integrator reached the end time (``status == "finished"``)."""
+        return self.status == "finished"
+
+    @property
+    def n_t(self) -> int:
+        """Number of output times."""
+        return int(self.t.shape[0])
+
+    def final_state(self) -> FinalState:
+        """Return time, coordinates, velocities and multipliers at the last output time."""
+        lam = None if self.lam is None else self.lam[-1].copy()
+        return FinalState(float(self.t[-1]), self.q[-1].copy(), self.v[-1].copy(), lam)
+
+    # -- tables ----------------------------------------------------------------------
+    def _frame(self, data: np.ndarray | dict[str, np.ndarray], columns: list[str] | None = None) -> pd.DataFrame:
+        body = pd.DataFrame(data, columns=columns) if columns is not None else pd.DataFrame(data)
+        body.insert(0, TIME_COLUMN, np.array(self.t))
+        body.attrs["meta"] = dict(self.meta)
+        body.attrs["status"] = self.status
+        return body
+
+    def coordinates(self) -> pd.DataFrame:
+        """Return the coordinates ``q`` as a DataFrame (``"t [s]"`` + one column per coordinate)."""
+        return self._frame(np.array(self.q), self.coordinate_names)
+
+    def velocities(self) -> pd.DataFrame:
+        """Return the velocities ``v`` as a DataFrame (``"t [s]"`` + one column per velocity)."""
+        return self._frame(np.array(self.v), self.velocity_names)
+
+    def multipliers(self) -> pd.DataFrame:
+        """Return the Lagrange multipliers ``lam`` as a DataFrame.
+
+        Raises
+        ------
+        ValueError
+            If the run did not record multipliers.
+        """
+        if self.lam is None:
+            raise ValueError(
+                f"this run (method {self.meta.get('method', '?')!r}) did not record Lagrange multipliers"
+            )
+        df = self._frame(np.array(self.lam), self.constraint_names)
+        df.attrs["units"] = (
+            "Units follow the constraint row: N for rows of Phi in m, N m for rows in rad "
+            "(Phi_q^T lam is a generalized force)."
+        )
+        return df
+
+    def violations(self) -> pd.DataFrame:
+        """Return the position- and velocity-level constraint violations over time."""
+        df = self._frame(
+            {
+                POSITION_VIOLATION_COLUMN: np.array(self.position_violation),
+                VELOCITY_VIOLATION_COLUMN: np.array(self.velocity_violation),
+            }
+        )
+        df.attrs["units"] = _VIOLATION_UNITS_NOTE
+        return df
+
+    def energy_table(self) -> pd.DataFrame:
+        """Return the energy, its drift ``E - E0`` and the relative drift over time.
+
+        The relative drift is ``(E - E0) / |E0|``, or ``(E - E0) / max|E|`` if
+        ``E0 == 0`` (zero if the energy is identically zero); the scale used is stored
+        in ``attrs["energy scale [J]"]``.
+
+        Raises
+        ------
+        ValueError
+            If the run did not record the energy.
+        """
+        if self.energy is None:
+            raise ValueError(
+                f"this run (model {self.meta.get('model', '?')!r}) did not record the energy "
+                "(only conservative systems do)"
+            )
+        energy = np.array(self.energy)
+        drift = energy - energy[0]
+        scale = abs(energy[0]) if energy[0] != 0 else float(np.max(np.abs(energy)))
+        relative = drift / scale if scale > 0 else np.zeros_like(drift)
+        df = self._frame(
+            {"energy [J]": energy, "energy drift [J]": drift, "relative energy drift [-]": relative}
+        )
+        df.attrs["energy scale [J]"] = scale
+        return df
+
+    def reactions_table(self, joint_name: str) -> pd.DataFrame:
+        """Return the reaction forces/torques of one joint over time.
+
+        Parameters
+        ----------
+        joint_name : str
+            Name of the joint as given in ``reactions``.
+        """
+        if joint_name not in self.reactions:
+            known = ", ".join(sorted(self.reactions)) or "none recorded"
+            raise ValueError(f"no reactions for joint {joint_name!r}; available: {known}")
+        df = self._frame(np.array(self.reactions[joint_name]), self.reaction_names[joint_name])
+        df.attrs["joint"] = joint_name
+        return df
+
+    def summary(self) -> pd.DataFrame:
+        """Return a one-row DataFrame: status, metadata, counters, final and max violations."""
+        row: dict[str, Any] = {
+            "status": self.status,
+            "message": self.message,
+            "n_t": self.n_t,
+            "t_end [s]": float(self.t[-1]),
+        }
+        row.update(_flatten(self.meta))
+        row.update({f"n {key}": value for key, value in self.counters.items()})
+        row["final " + POSITION_VIOLATION_COLUMN] = float(self.position_violation[-1])
+        row["final " + VELOCITY_VIOLATION_COLUMN] = float(self.velocity_violation[-1])
+        row["max " + POSITION_VIOLATION_COLUMN] = float(np.nanmax(self.position_violation))
+        row["max " + VELOCITY_VIOLATION_COLUMN] = float(np.nanmax(self.velocity_violation))
+        if self.energy is not None:
+            energy_df = self.energy_table()
+            row["max |relative energy drift| [-]"] = float(np.nanmax(np.abs(energy_df["relative energy drift [-]"])))
+        df = pd.DataFrame([row])
+        df.attrs["meta"] = dict(self.meta)
+        return df
+
+    def to_frame(self) -> pd.DataFrame:
+        """Return one DataFrame with time, coordinates, velocities, multipliers, violations, energy.
+
+        Raises
+        ------
+        ValueError
+            If two parts share a column name (e.g. a coordinate named like a velocity).
+        """
+        parts = [self.coordinates(), self.velocities()]
+        if self.lam is not None:
+            parts.append(self.multipliers())
+        parts.append(self.violations())
+        if self.energy is not None:
+            parts.append(self.energy_table())
+        columns: list[str] = []
+        for part in parts:
+            columns.extend(part.columns[1:])
+        dupes = sorted({c for c in columns if columns.count(c) > 1})
+        if dupes:
+            raise ValueError(f"SimulationResult.to_frame: duplicate column names {dupes}")
+        df = pd.concat([parts[0]] + [p.drop(columns=TIME_COLUMN) for p in parts[1:]], axis=1)
+        df.attrs = {"meta": dict(self.meta), "status": self.status, "units": _VIOLATION_UNITS_NOTE}
+        return df

@@ -1,0 +1,111 @@
+"""Parameter sweeps over any :class:`concurrent.futures.Executor`.
+
+A sweep maps a pure function over a list of cases, ``results[i] = fn(cases[i])``.
+Where the calls run is the caller's choice, and the result does not depend on it:
+
+* ``executor=None`` -- a plain serial loop in this process. This is the reference
+  result; tests compare every parallel route against it.
+* one machine -- ``concurrent.futures.ProcessPoolExecutor(max_workers=n)`` from the
+  standard library; nothing to install, no server.
+* beyond one machine -- ``dask.distributed`` (extra ``mbsuite[parallel]``).
+  ``Client(...).get_executor()`` returns an object that *is* a
+  ``concurrent.futures.Executor``, so it is passed here unchanged::
+
+      from dask.distributed import Client, LocalCluster
+      with Client(LocalCluster(n_workers=4)) as client:      # or Client("tcp://host:8786"),
+          rows = run_sweep(fn, cases, executor=client.get_executor())  # SSHCluster, dask-jobqueue
+
+Rules for ``fn`` so that every route gives the same answer:
+
+* a module-level (picklable) function of the case alone; randomness only through
+  ``np.random.default_rng(seed)`` with the seed inside the case;
+* return small values (a row dict, a small DataFrame) rather than writing to a shared
+  file; a case that needs large output writes its own shard;
+* set ``OMP_NUM_THREADS=1`` / ``OPENBLAS_NUM_THREADS=1`` for worker processes so BLAS
+  threads do not oversubscribe the cores.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+from collections.abc import Callable, Iterable
+from typing import TypeVar
+
+__all__ = ["run_sweep"]
+
+C = TypeVar("C")
+R = TypeVar("R")
+
+
+def run_sweep(
+    fn: Callable[[C], R],
+    cases: Iterable[C],
+    executor: concurrent.futures.Executor | None = None,
+    progress: bool = False,
+) -> list[R]:
+    """Evaluate ``fn`` for every case and return the results in case order.
+
+    Parameters
+    ----------
+    fn : callable
+        ``fn(case) -> result``; must be picklable (module-level) when an executor
+        runs it in other processes.
+    cases : iterable
+        The cases; materialised into a list first.
+    executor : concurrent.futures.Executor, optional
+        None runs serially in this process (the reference). Otherwise every case is
+        submitted with ``executor.submit(fn, case)``; the executor is not shut down.
+    progress : bool, optional
+        Show a tqdm bar (over cases, or over completed futures); silent when stderr is
+        not a terminal.
+
+    Returns
+    -------
+    list
+        ``[fn(case) for case in cases]``, in case order whatever the completion order.
+
+    Raises
+    ------
+    Exception
+        The first failing case's exception (in case order), with a note naming the case
+        index; the remaining not-yet-started cases are cancelled.
+    """
+    cases = list(cases)
+    if executor is None:
+        iterator: Iterable[tuple[int, C]] = enumerate(cases)
+        if progress:
+            from tqdm import tqdm
+
+            iterator = tqdm(iterator, total=len(cases), desc="sweep", unit="case", disable=None)
+        results: list[R] = []
+        for i, case in iterator:
+            try:
+                results.append(fn(case))
+            except Exception as exc:
+                exc.add_note(f"run_sweep: case {i} ({case!r}) failed")
+                raise
+        return results
+
+    if not isinstance(executor, concurrent.futures.Executor):
+        raise TypeError(f"executor must be a concurrent.futures.Executor or None, got {type(executor).__name__}")
+    futures = [executor.submit(fn, case) for case in cases]
+    try:
+        if progress:
+            from tqdm import tqdm
+
+            for _ in tqdm(
+                concurrent.futures.as_completed(futures), total=len(futures), desc="sweep", unit="case", disable=None
+            ):
+                pass
+        results = []
+        for i, future in enumerate(futures):
+            try:
+                results.append(future.result())
+            except Exception as exc:
+                exc.add_note(f"run_sweep: case {i} ({cases[i]!r}) failed")
+                raise
+    except BaseException:
+        for future in futures:
+            future.cancel()
+        raise
+    return results

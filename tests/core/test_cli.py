@@ -1,0 +1,208 @@
+"""The ``mbsuite`` command line, the scene registry and scene output."""
+
+from __future__ import annotations
+
+import importlib.metadata
+import importlib.util
+import subprocess
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import core
+from core import cli, scenes
+from core.scenes import PluginLoadWarning, Scene, SceneError, SceneResult, run_scene
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _table_scene(ctx):
+    from matplotlib.figure import Figure
+
+    n = 5 if ctx.fast else 50
+    t = np.linspace(0.0, 1.0, n)
+    fig = Figure()
+    fig.add_subplot().plot(t, t**2)
+    total = sum(ctx.progress(range(n), desc="inner"))
+    return SceneResult(
+        tables={"parabola": pd.DataFrame({"t [s]": t, "x [m]": t**2})},
+        figures={"parabola": fig},
+        notes=f"fast={ctx.fast}, sum={total}",
+    )
+
+
+def _broken_scene(ctx):
+    raise RuntimeError("deliberate failure in scene body")
+
+
+OK_SCENE = Scene("ok-scene", "A parabola", "x = t^2 sampled on [0, 1].", _table_scene)
+BAD_SCENE = Scene("bad_scene", "Always fails", "Raises on purpose.", _broken_scene)
+
+
+@pytest.fixture
+def registry(monkeypatch):
+    """An isolated scene registry holding OK_SCENE and BAD_SCENE, and no plug-ins."""
+    reg: dict[str, Scene] = {}
+    monkeypatch.setattr(scenes, "_REGISTRY", reg)
+    monkeypatch.setattr(scenes, "_DEMO_MODULE", "core._no_such_demo_module")
+    monkeypatch.setattr(scenes, "_scene_entry_points", lambda: [])
+    scenes.register_scene(OK_SCENE)
+    scenes.register_scene(BAD_SCENE)
+    return reg
+
+
+def test_version(capsys):
+    assert cli.main(["--version"]) == 0
+    assert capsys.readouterr().out.strip() == f"mbsuite {core.__version__}"
+
+
+def test_version_matches_installed_metadata():
+    try:
+        installed = importlib.metadata.version("mbsuite")
+    except importlib.metadata.PackageNotFoundError:
+        pytest.skip("mbsuite is not installed (running from a bare checkout)")
+    assert installed == core.__version__
+
+
+def test_help_in_subprocess():
+    out = subprocess.run(
+        [sys.executable, "-m", "core.cli", "--help"], capture_output=True, text=True, cwd=REPO, check=False
+    )
+    assert out.returncode == 0, out.stderr
+    assert "list" in out.stdout and "run" in out.stdout
+
+
+def test_console_script_installed():
+    script = Path(sys.executable).parent / "mbsuite"
+    if not script.exists():
+        pytest.skip("console script not installed in this environment")
+    out = subprocess.run([str(script), "--version"], capture_output=True, text=True, check=False)
+    assert out.returncode == 0 and out.stdout.startswith("mbsuite ")
+
+
+def test_no_command_is_usage_error(capsys):
+    assert cli.main([]) == 2
+    assert "usage" in capsys.readouterr().err
+
+
+def test_list(registry, capsys):
+    assert cli.main(["list"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split(None, 1) == ["ok-scene", "A parabola"]
+    assert lines[1].split(None, 1) == ["bad_scene", "Always fails"]
+
+
+def test_run_usage_errors(registry, capsys, tmp_path):
+    assert cli.main(["run", "-o", str(tmp_path)]) == 2
+    assert cli.main(["run", "ok-scene", "--all", "-o", str(tmp_path)]) == 2
+    assert cli.main(["run", "missing", "-o", str(tmp_path)]) == 2
+    assert "unknown scene(s): missing (available: ok-scene, bad_scene)" in capsys.readouterr().err
+
+
+def test_run_one_scene_writes_tables_figures_readme(registry, tmp_path, capsys):
+    assert cli.main(["run", "ok-scene", "-o", str(tmp_path), "--fast"]) == 0
+    folder = tmp_path / "ok-scene"
+    assert sorted(p.name for p in folder.iterdir()) == ["README.md", "parabola.csv", "parabola.md", "parabola.png"]
+    df = pd.read_csv(folder / "parabola.csv")
+    assert len(df) == 5  # fast mode reached the scene
+    readme = (folder / "README.md").read_text()
+    assert "# A parabola" in readme and "parabola.csv" in readme and "parabola.png" in readme
+    assert "fast=True, sum=10" in readme
+    assert "ok-scene" in (tmp_path / "README.md").read_text()
+
+
+def test_run_all_continues_after_failure_and_exits_nonzero(registry, tmp_path, capsys):
+    assert cli.main(["run", "--all", "-o", str(tmp_path)]) == 1
+    err = capsys.readouterr().err
+    assert "1 of 2 scene(s) failed: bad_scene" in err
+    error_txt = (tmp_path / "bad_scene" / "error.txt").read_text()
+    assert "RuntimeError: deliberate failure in scene body" in error_txt and "Traceback" in error_txt
+    assert (tmp_path / "ok-scene" / "parabola.png").exists()
+    index = (tmp_path / "README.md").read_text()
+    assert "| failed |" in index and "| ok |" in index
+
+
+def test_run_scene_raises_scene_error_and_clears_stale_error(tmp_path):
+    with pytest.raises(SceneError, match="bad_scene") as info:
+        run_scene(BAD_SCENE, tmp_path)
+    assert isinstance(info.value.__cause__, RuntimeError)
+    assert (tmp_path / "bad_scene" / "error.txt").exists()
+    (tmp_path / "ok-scene").mkdir()
+    (tmp_path / "ok-scene" / "error.txt").write_text("stale")
+    result = run_scene(OK_SCENE, tmp_path)
+    assert isinstance(result, SceneResult)
+    assert not (tmp_path / "ok-scene" / "error.txt").exists()
+
+
+def test_scene_returning_wrong_type_fails(tmp_path):
+    scene = Scene("wrong", "Wrong", "", lambda ctx: {"tables": {}})
+    with pytest.raises(SceneError, match="expected SceneResult"):
+        run_scene(scene, tmp_path)
+
+
+def test_scene_validation_and_duplicates(registry):
+    with pytest.raises(ValueError, match="lower-case"):
+        Scene("Bad Name", "t", "d", _table_scene)
+    with pytest.raises(ValueError, match="callable"):
+        Scene("x", "t", "d", run=42)
+    scenes.register_scene(OK_SCENE)  # same object again: fine
+    with pytest.raises(ValueError, match="already registered"):
+        scenes.register_scene(Scene("ok-scene", "other", "", _table_scene))
+
+
+def _fake_entry_point(monkeypatch, module_name, attr, value, group):
+    module = types.ModuleType(module_name)
+    setattr(module, attr, value)
+    monkeypatch.setitem(sys.modules, module_name, module)
+    return importlib.metadata.EntryPoint(name=module_name, value=f"{module_name}:{attr}", group=group)
+
+
+def test_scene_plugins_from_entry_points(registry, monkeypatch):
+    extra = Scene("plugin-scene", "From a plug-in", "", _table_scene)
+    good = _fake_entry_point(monkeypatch, "fake_scene_plugin", "scenes", lambda: [extra], "mbsuite.scenes")
+    broken = importlib.metadata.EntryPoint(
+        name="broken", value="no_such_module_for_mbsuite:scenes", group="mbsuite.scenes"
+    )
+    monkeypatch.setattr(scenes, "_scene_entry_points", lambda: [broken, good])
+    with pytest.warns(PluginLoadWarning, match="broken"):
+        found = scenes.all_scenes()
+    assert list(found) == ["ok-scene", "bad_scene", "plugin-scene"]
+
+    clash = _fake_entry_point(
+        monkeypatch, "clash_plugin", "scenes", lambda: [Scene("ok-scene", "dup", "", _table_scene)], "mbsuite.scenes"
+    )
+    monkeypatch.setattr(scenes, "_scene_entry_points", lambda: [clash])
+    with pytest.raises(ValueError, match="'ok-scene' is provided by both core and plug-in clash_plugin"):
+        scenes.all_scenes()
+
+
+def test_command_plugins(monkeypatch, capsys):
+    def register(subparsers):
+        p = subparsers.add_parser("hello", help="say hello")
+        p.add_argument("--name", default="world")
+        p.set_defaults(func=lambda args: print(f"hello {args.name}") or 0)
+
+    good = _fake_entry_point(monkeypatch, "fake_cmd_plugin", "register", register, "mbsuite.commands")
+    broken = importlib.metadata.EntryPoint(
+        name="broken", value="no_such_module_for_mbsuite.cli:register", group="mbsuite.commands"
+    )
+    monkeypatch.setattr(cli, "_command_entry_points", lambda: [broken, good])
+    assert cli.main(["hello", "--name", "rail"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.strip() == "hello rail"
+    assert "plug-in command 'broken'" in captured.err and "ModuleNotFoundError" in captured.err
+    assert cli.main(["--help"]) == 0
+    assert "hello" in capsys.readouterr().out
+
+
+def test_registered_command_plugins_load():
+    """Entry points declared in pyproject.toml must load once their module exists."""
+    for ep in cli._command_entry_points():
+        module = ep.value.split(":")[0]
+        if importlib.util.find_spec(module.split(".")[0]) is None or importlib.util.find_spec(module) is None:
+            continue  # the plug-in's package is still being written
+        assert callable(ep.load()), ep

@@ -117,7 +117,8 @@ class Integrator:
             ok, msg = self._step_impl()
         except IntegrationFailure as exc:
             ok, msg = False, str(exc)
-        except (np.linalg.LinAlgError, FloatingPointError, ArithmeticError) as exc:
+        except (np.linalg.LinAlgError, FloatingPointError, ArithmeticError, ValueError) as exc:
+            # ValueError: e.g. LAPACK refusing non-finite input in a fallback solve
             ok, msg = False, f"{type(exc).__name__}: {exc}"
         if ok and not (np.all(np.isfinite(self.q)) and np.all(np.isfinite(self.v))):
             ok, msg = False, "state became non-finite (NaN or Inf): the integration diverged"

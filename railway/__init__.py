@@ -1,0 +1,64 @@
+"""Railway wheel-rail geometry, contact search and contact-geometry tables.
+
+Geometry half of the railway domain (Hertz and creep laws live in :mod:`railway.hertz` and the
+creep modules):
+
+* :mod:`railway.profiles` -- S1002 wheel (analytic definition), UIC60 rail (arcs) and measured
+  profiles, as smooth curves with first and second derivatives;
+* :mod:`railway.track` -- track centreline (straight, circular curve, clothoid), cant,
+  irregularities, moving track frame, rail mounting (inclination, gauge at 14 mm);
+* :mod:`railway.surfaces` -- wheel surface of revolution and swept rail surface;
+* :mod:`railway.contact_search` -- vectorised four-condition contact search (Pombo, Ambrosio &
+  Silva 2007) with tread and flange candidates, global re-seeding and warm starts;
+* :mod:`railway.contact_geometry` -- rigid contact-geometry table and equivalent conicity
+  (EN 15302).
+
+SI units throughout (m, rad); mm only in profile files and CLI output.
+"""
+
+from .contact_geometry import (
+    conicity_table,
+    contact_geometry_table,
+    equivalent_conicity,
+    flange_contact_onset,
+    rigid_contact,
+)
+from .contact_search import ContactResult, ContactSearch, wheelset_pose
+from .profiles import RailProfile, WheelProfile, read_profile_file, s1002_exact, uic60_exact
+from .surfaces import RailSurface, WheelSurface
+from .track import (
+    Curve,
+    Irregularities,
+    RailMounting,
+    Straight,
+    Track,
+    TrackFrame,
+    Transition,
+    parse_inclination,
+)
+
+__all__ = [
+    "ContactResult",
+    "ContactSearch",
+    "Curve",
+    "Irregularities",
+    "RailMounting",
+    "RailProfile",
+    "RailSurface",
+    "Straight",
+    "Track",
+    "TrackFrame",
+    "Transition",
+    "WheelProfile",
+    "WheelSurface",
+    "conicity_table",
+    "contact_geometry_table",
+    "equivalent_conicity",
+    "flange_contact_onset",
+    "parse_inclination",
+    "read_profile_file",
+    "rigid_contact",
+    "s1002_exact",
+    "uic60_exact",
+    "wheelset_pose",
+]

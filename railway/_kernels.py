@@ -1,0 +1,303 @@
+"""Optional compiled (numba) Newton kernel of the contact search.
+
+The numpy implementation in :mod:`railway.contact_search` is the reference; this module holds
+the same four-condition Newton iteration (residual, analytic Jacobian, step limiting,
+backtracking across passes, zone clipping, linearised last step) written per problem for numba.
+It is used only when numba is installed (``pip install numba``); the benchmark
+``benchmarks/railway_contact_speed.py`` shows why (the per-call numpy overhead dominates for the
+16 small problems of a 4-wheelset vehicle).  Tests check that both give the same contacts.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+try:  # optional dependency
+    import numba
+
+    HAVE_NUMBA = True
+except ImportError:  # pragma: no cover - exercised only without numba
+    numba = None
+    HAVE_NUMBA = False
+
+__all__ = ["HAVE_NUMBA", "newton_kernel"]
+
+
+def _define():
+    njit = numba.njit(cache=True, fastmath=False)
+
+    @njit
+    def ppeval(inner, breaks, stack, x, out):
+        i = np.searchsorted(inner, x, side="right")
+        t = x - breaks[i]
+        k1 = stack.shape[1]
+        q = stack.shape[2]
+        for c in range(q):
+            acc = 0.0
+            for j in range(k1 - 1, -1, -1):
+                acc = acc * t + stack[i, j, c]
+            out[c] = acc
+
+    @njit
+    def cross(a, b, out):
+        out[0] = a[1] * b[2] - a[2] * b[1]
+        out[1] = a[2] * b[0] - a[0] * b[2]
+        out[2] = a[0] * b[1] - a[1] * b[0]
+
+    @njit
+    def dot(a, b):
+        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+    @njit
+    def matvec(A, v, out):
+        for i in range(3):
+            out[i] = A[i, 0] * v[0] + A[i, 1] * v[1] + A[i, 2] * v[2]
+
+    @njit
+    def solve4(J, h, dx):
+        M = np.empty((4, 5))
+        for i in range(4):
+            for j in range(4):
+                M[i, j] = J[i, j]
+            M[i, 4] = -h[i]
+        for c in range(4):
+            piv = c
+            for rr in range(c + 1, 4):
+                if abs(M[rr, c]) > abs(M[piv, c]):
+                    piv = rr
+            if abs(M[piv, c]) < 1e-300:
+                for k in range(4):
+                    dx[k] = 0.0
+                return
+            if piv != c:
+                for k in range(5):
+                    tmp = M[c, k]
+                    M[c, k] = M[piv, k]
+                    M[piv, k] = tmp
+            for rr in range(c + 1, 4):
+                f = M[rr, c] / M[c, c]
+                for k in range(c, 5):
+                    M[rr, k] -= f * M[c, k]
+        for c in range(3, -1, -1):
+            acc = M[c, 4]
+            for k in range(c + 1, 4):
+                acc -= M[c, k] * dx[k]
+            dx[c] = acc / M[c, c]
+
+    @njit
+    def evaluate(x, sig, r0, L, ow, orr, Y0, Z0, ca, sa, rws, A,
+                 b_inner, b_breaks, b_stack, f_inner, f_breaks, f_stack,
+                 h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal, W, o):
+        th, yw, s, u = x[0], x[1], x[2], x[3]
+        pr = W[0]
+        ppeval(b_inner, b_breaks, b_stack, yw + ow, pr)
+        F, F1, F2 = pr[0], pr[1], pr[2]
+        ppeval(b_inner, b_breaks, b_stack, u + orr, pr)
+        v, v1, v2 = pr[0], pr[1], pr[2]
+        r = r0 + F
+        st, ct = np.sin(th), np.cos(th)
+        loc = W[1]
+        loc[0] = r * st; loc[1] = sig * (yw + L); loc[2] = -r * ct
+        matvec(A, loc, p)
+        for k in range(3):
+            p[k] += rws[k]
+        loc[0] = ct; loc[1] = 0.0; loc[2] = st
+        matvec(A, loc, tth)
+        loc[0] = F1 * st; loc[1] = sig; loc[2] = -F1 * ct
+        matvec(A, loc, ty)
+        dtth = W[2]
+        loc[0] = -st; loc[1] = 0.0; loc[2] = ct
+        matvec(A, loc, dtth)
+        dtyy = W[3]
+        loc[0] = F2 * st; loc[1] = 0.0; loc[2] = -F2 * ct
+        matvec(A, loc, dtyy)
+        # track frame
+        ppeval(f_inner, f_breaks, f_stack, s, o)
+        for i in range(3):
+            for j in range(3):
+                R[i, j] = o[3 + 3 * i + j]
+        om = o[12:15]
+        dpos = o[15:18]
+        dom = o[27:30]
+        ddpos = o[30:33]
+        a = Y0 + u * ca - v * sa
+        b = Z0 + u * sa + v * ca
+        loc[0] = 0.0; loc[1] = sig * a; loc[2] = b
+        matvec(R, loc, Rl)
+        loc[0] = 0.0; loc[1] = sig * (ca - v1 * sa); loc[2] = sa + v1 * ca
+        matvec(R, loc, tu)
+        dtuu = W[4]
+        loc[0] = 0.0; loc[1] = -sig * v2 * sa; loc[2] = v2 * ca
+        matvec(R, loc, dtuu)
+        for k in range(3):
+            q[k] = o[k] + Rl[k]
+        omRl = W[5]; omtu = W[6]; tmp = W[7]; tmp2 = W[8]
+        cross(om, Rl, omRl)
+        cross(om, tu, omtu)
+        cross(dom, Rl, tmp)
+        cross(om, omRl, tmp2)
+        for k in range(3):
+            ts[k] = dpos[k] + omRl[k]
+            qss[k] = ddpos[k] + tmp[k] + tmp2[k]
+        c = W[9]
+        cross(ts, tu, c)
+        cn = np.sqrt(dot(c, c))
+        for k in range(3):
+            n[k] = sig * c[k] / cn
+            d[k] = p[k] - q[k]
+        # dn/ds, dn/du
+        dcs = W[10]; dcu = W[11]
+        cross(qss, tu, tmp)
+        cross(ts, omtu, tmp2)
+        for k in range(3):
+            dcs[k] = sig * (tmp[k] + tmp2[k]) / cn
+        cross(omtu, tu, tmp)
+        cross(ts, dtuu, tmp2)
+        for k in range(3):
+            dcu[k] = sig * (tmp[k] + tmp2[k]) / cn
+        ps, pu = dot(dcs, n), dot(dcu, n)
+        for k in range(3):
+            dn[0, k] = dcs[k] - ps * n[k]
+            dn[1, k] = dcu[k] - pu * n[k]
+        h[0] = dot(n, tth); h[1] = dot(n, ty); h[2] = dot(d, ts); h[3] = dot(d, tu)
+        J[0, 0] = dot(n, dtth); J[0, 1] = 0.0
+        J[0, 2] = dot(dn[0], tth); J[0, 3] = dot(dn[1], tth)
+        J[1, 0] = F1 * h[0]; J[1, 1] = dot(n, dtyy)
+        J[1, 2] = dot(dn[0], ty); J[1, 3] = dot(dn[1], ty)
+        J[2, 0] = r * dot(tth, ts); J[2, 1] = dot(ty, ts)
+        J[2, 2] = -dot(ts, ts) + dot(d, qss); J[2, 3] = -dot(tu, ts) + dot(d, omtu)
+        J[3, 0] = r * dot(tth, tu); J[3, 1] = dot(ty, tu)
+        J[3, 2] = -dot(ts, tu) + dot(d, omtu); J[3, 3] = -dot(tu, tu) + dot(d, dtuu)
+        scal[0] = r; scal[1] = F1; scal[2] = F2; scal[3] = v1; scal[4] = v2
+
+    @njit
+    def newton(x0, sig, r0, L, ow, orr, Y0, Z0, ca, sa, lo, hi, rws, A,
+               b_inner, b_breaks, b_stack, f_inner, f_breaks, f_stack,
+               tol_lin, max_iter, maxstep, wts):
+        P = x0.shape[0]
+        X = x0.copy()
+        H0 = np.zeros((P, 4)); conv = np.zeros(P, dtype=np.bool_)
+        GAP = np.empty(P); S = np.empty((P, 11)); V = np.empty((P, 3, 3))
+        h = np.empty(4); J = np.empty((4, 4)); dx = np.empty(4)
+        p = np.empty(3); q = np.empty(3); n = np.empty(3); d = np.empty(3); ts = np.empty(3)
+        Rl = np.empty(3); qss = np.empty(3); tth = np.empty(3); ty = np.empty(3); tu = np.empty(3)
+        dn = np.empty((2, 3)); R = np.empty((3, 3)); scal = np.empty(5)
+        x = np.empty(4); x_acc = np.empty(4); dx_acc = np.zeros(4); xn = np.empty(4)
+        W = np.empty((12, 3)); o = np.empty(f_stack.shape[2])
+        max_it = 0
+        for pi in range(P):
+            for k in range(4):
+                x[k] = x0[pi, k]
+                x_acc[k] = x[k]
+                dx_acc[k] = 0.0
+            phi_acc = np.inf
+            alpha = 1.0
+            was_clipped = False
+            cvd = False
+            it = 0
+            for it in range(1, max_iter + 1):
+                evaluate(x, sig[pi], r0[pi], L[pi], ow[pi], orr[pi], Y0[pi], Z0[pi], ca[pi],
+                         sa[pi], rws[pi], A[pi], b_inner, b_breaks, b_stack, f_inner, f_breaks,
+                         f_stack, h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal, W, o)
+                solve4(J, h, dx)
+                big = 0.0
+                scale = 1.0
+                for k in range(4):
+                    if not np.isfinite(dx[k]):
+                        dx[k] = 0.0
+                    a_ = abs(dx[k])
+                    if a_ > 0.0 and maxstep[k] / a_ < scale:
+                        scale = maxstep[k] / a_
+                for k in range(4):
+                    dx[k] *= scale
+                    if abs(dx[k]) > big:
+                        big = abs(dx[k])
+                phi = 0.0
+                for k in range(4):
+                    phi += (h[k] * wts[k]) ** 2
+                accept = (phi <= phi_acc * (1.0 - 1e-4 * alpha)) or (phi < 1e-26) or (phi_acc == np.inf)
+                done = False
+                if accept and (big < tol_lin or phi < 1e-26):
+                    cvd = True
+                    done = True
+                else:
+                    if accept:
+                        alpha = 1.0
+                        phi_acc = phi
+                        for k in range(4):
+                            x_acc[k] = x[k]
+                            dx_acc[k] = dx[k]
+                    else:
+                        alpha *= 0.25
+                    clipped = False
+                    for k in range(4):
+                        xn[k] = x_acc[k] + alpha * dx_acc[k]
+                        if xn[k] < lo[pi, k] or xn[k] > hi[pi, k]:
+                            clipped = True
+                    clipped = clipped and accept
+                    stuck = (clipped and was_clipped) or alpha < 1e-4
+                    if accept:
+                        was_clipped = clipped
+                    if stuck or it == max_iter:
+                        done = True
+                if done:
+                    break
+                for k in range(4):
+                    x[k] = min(max(xn[k], lo[pi, k]), hi[pi, k])
+            if it > max_it:
+                max_it = it
+            # store the evaluated point (plus the linearised last step when converged)
+            r = scal[0]
+            if cvd:
+                dth, dy, ds, du = dx[0], dx[1], dx[2], dx[3]
+                nn = 0.0
+                for k in range(3):
+                    p[k] += r * dth * tth[k] + dy * ty[k]
+                    q[k] += ds * ts[k] + du * tu[k]
+                    n[k] += ds * dn[0, k] + du * dn[1, k]
+                    Rl[k] += du * tu[k]
+                    nn += n[k] * n[k]
+                nn = np.sqrt(nn)
+                for k in range(3):
+                    n[k] /= nn
+                    d[k] = p[k] - q[k]
+                scal[0] = r + scal[1] * dy
+                for k in range(4):
+                    x[k] += dx[k]
+            for k in range(4):
+                X[pi, k] = x[k]
+                H0[pi, k] = h[k]
+            conv[pi] = cvd
+            # outputs: gap, parameters, rolling radius, contact angle, wheel angle, curvatures
+            F1, F2, v1, v2 = scal[1], scal[2], scal[3], scal[4]
+            wq = 1.0 + F1 * F1
+            GAP[pi] = dot(d, n)
+            nl = n[0] * R[0, 1] + n[1] * R[1, 1] + n[2] * R[2, 1]
+            nu = n[0] * R[0, 2] + n[1] * R[1, 2] + n[2] * R[2, 2]
+            for k in range(4):
+                S[pi, k] = x[k]
+            S[pi, 4] = scal[0]
+            S[pi, 5] = np.arctan2(-sig[pi] * nl, nu)
+            S[pi, 6] = np.arctan(-F1)
+            S[pi, 7] = 1.0 / (scal[0] * np.sqrt(wq))
+            S[pi, 8] = -F2 / wq**1.5
+            S[pi, 9] = -dot(n, qss) / dot(ts, ts)
+            S[pi, 10] = -v2 / (1.0 + v1 * v1) ** 1.5
+            for k in range(3):
+                V[pi, 0, k] = p[k]; V[pi, 1, k] = q[k]; V[pi, 2, k] = n[k]
+        return X, H0, conv, max_it, GAP, S, V
+
+    return newton
+
+
+_NEWTON = None
+
+
+def newton_kernel():
+    """The compiled Newton kernel (compiled on first use), or None without numba."""
+    global _NEWTON
+    if not HAVE_NUMBA:
+        return None
+    if _NEWTON is None:
+        _NEWTON = _define()
+    return _NEWTON

@@ -1,0 +1,529 @@
+"""Track centreline, moving track frame and rail mounting.
+
+Centreline and frame
+--------------------
+The design centreline is parameterised by its arc length s (m) and built from straights,
+circular curves and clothoid transitions.  Horizontal curvature kappa(s) is constant on straights
+(0) and curves (1/R, R > 0 for a curve to the left) and linear in s on a clothoid; the cant
+(superelevation) angle phi(s) is constant on curves and linear on transitions::
+
+    psi(s) = psi_0 + int kappa ds                (heading, exact: piecewise quadratic)
+    X(s) = X_0 + int cos psi ds,  Y(s) = Y_0 + int sin psi ds   (Gauss-Legendre per interval)
+    phi = -sign(kappa) asin(h / b0)               (h cant height of the outer rail, b0 = 1.5 m)
+
+The track frame R = [t, n, b] (columns: tangent, lateral to the left, up) is the heading
+rotation followed by the cant roll about t::
+
+    R = Rz(psi) Rx(phi),   t = (c_psi, s_psi, 0),  n = (-s_psi c_phi, c_psi c_phi, s_phi),
+    b = (s_psi s_phi, -c_psi s_phi, c_phi)
+    dR/ds = [omega]x R,    omega = psi' e_z + phi' t     (Darboux vector)
+
+Optional irregularities y_i(s) (lateral alignment) and z_i(s) (vertical level) from a table,
+interpolated by a C2 cubic spline, displace the centreline in the frame::
+
+    r(s) = (X, Y, 0) + y_i n + z_i b
+    r'(s) = (X', Y', 0) + y_i' n + z_i' b + omega x (y_i n + z_i b)
+
+s stays the arc length of the design line (irregularities are small; the usual convention of
+vehicle-dynamics codes).  All quantities are stored as one vector-valued piecewise quintic
+Hermite polynomial (exact for psi, phi and the cubic irregularity spline) and evaluated with
+their first and second derivatives in one vectorised call.
+
+Rail mounting
+-------------
+A rail profile v(u) (u > 0 field side, v up) is inclined by alpha = atan(inclination) towards the
+track centre and placed so that its highest point is at z = 0 of the track frame and its gauge
+point (the gauge-side point ``gauge_depth`` = 14 mm below the highest point) is at lateral
+distance gauge/2 from the centreline.  In the outward lateral coordinate Yo (= sigma y, sigma =
++1 left rail, -1 right rail) and height Z::
+
+    Yo(u) = Y0 + u cos(alpha) - v(u) sin(alpha),   Z(u) = Z0 + u sin(alpha) + v(u) cos(alpha)
+
+References
+----------
+Pombo, J. and Ambrosio, J. (2003). General spatial curve joint for rail guided vehicles:
+kinematics and dynamics. Multibody System Dynamics 9(3):237-264 (moving track frame).
+EN 13848-1:2019, Track geometry quality (gauge measured 14 mm below the running surface).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ._ppoly import PiecewisePoly, quintic_hermite_coeffs
+from .profiles import RailProfile
+
+__all__ = [
+    "Straight",
+    "Curve",
+    "Transition",
+    "Irregularities",
+    "Track",
+    "TrackFrame",
+    "RailMounting",
+    "parse_inclination",
+]
+
+
+@dataclass(frozen=True)
+class Straight:
+    """Straight track of ``length`` (m)."""
+
+    length: float
+
+
+@dataclass(frozen=True)
+class Curve:
+    """Circular curve: ``radius`` (m, > 0 turns left, < 0 right), cant height ``cant`` (m)."""
+
+    length: float
+    radius: float
+    cant: float = 0.0
+
+
+@dataclass(frozen=True)
+class Transition:
+    """Clothoid transition: curvature and cant change linearly between its neighbours."""
+
+    length: float
+
+
+@dataclass
+class Irregularities:
+    """Lateral (alignment) and vertical (level) centreline irregularities y_i(s), z_i(s) (m).
+
+    Zero outside [s[0], s[-1]]; the table should start and end at zero.
+    """
+
+    s: np.ndarray
+    lateral: np.ndarray
+    vertical: np.ndarray
+
+    def __post_init__(self):
+        self.s = np.asarray(self.s, dtype=float)
+        self.lateral = np.asarray(self.lateral, dtype=float)
+        self.vertical = np.asarray(self.vertical, dtype=float)
+        for name, a in (("s", self.s), ("lateral", self.lateral), ("vertical", self.vertical)):
+            if a.ndim != 1 or a.size != self.s.size:
+                raise ValueError(f"irregularities: column {name} must be 1-D of length {self.s.size}")
+            bad = ~np.isfinite(a)
+            if np.any(bad):
+                i = int(np.argmax(bad))
+                raise ValueError(f"irregularities: {name}[{i}] = {a[i]!r} is not finite")
+        if self.s.size < 4:
+            raise ValueError("irregularities: at least 4 rows are needed")
+        d = np.diff(self.s)
+        if np.any(d <= 0):
+            i = int(np.argmax(d <= 0)) + 1
+            raise ValueError(f"irregularities: s must increase strictly; s[{i}] = {self.s[i]!r}")
+
+    @classmethod
+    def from_csv(cls, path):
+        """Read columns ``s [m]``, ``lateral [m]``, ``vertical [m]`` (header required; mm columns
+        named ``lateral [mm]`` / ``vertical [mm]`` are converted)."""
+        import pandas as pd
+
+        df = pd.read_csv(path)
+        cols = {c.strip().lower(): c for c in df.columns}
+
+        def col(base):
+            for unit, f in (("[m]", 1.0), ("[mm]", 1e-3)):
+                key = f"{base} {unit}"
+                if key in cols:
+                    return df[cols[key]].to_numpy(float) * f
+            raise ValueError(f"{path}: missing column '{base} [m]' (or [mm]); found {list(df.columns)}")
+
+        return cls(col("s"), col("lateral"), col("vertical"))
+
+
+@dataclass
+class TrackFrame:
+    """Track frame and derivatives at arc lengths s (arrays over N points).
+
+    Attributes
+    ----------
+    position, dposition, ddposition : (N, 3) ndarray
+        Centreline r(s) (m), r'(s) (-), r''(s) (1/m).
+    R : (N, 3, 3) ndarray
+        Columns tangent t, lateral n (left), up b.
+    omega, domega : (N, 3) ndarray
+        Darboux vector (1/m) with dR/ds = [omega]x R, and its derivative (1/m^2).
+    curvature, cant_angle, heading : (N,) ndarray
+        kappa (1/m), phi (rad), psi (rad).
+    """
+
+    position: np.ndarray
+    dposition: np.ndarray
+    ddposition: np.ndarray
+    R: np.ndarray
+    omega: np.ndarray
+    domega: np.ndarray
+    curvature: np.ndarray
+    cant_angle: np.ndarray
+    heading: np.ndarray
+
+    @property
+    def tangent(self):
+        return self.R[:, :, 0]
+
+    @property
+    def lateral(self):
+        return self.R[:, :, 1]
+
+    @property
+    def up(self):
+        return self.R[:, :, 2]
+
+    def dR(self):
+        """dR/ds = [omega]x R, (N, 3, 3)."""
+        return np.cross(self.omega[:, None, :], np.swapaxes(self.R, 1, 2)).swapaxes(1, 2)
+
+
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
+_I1, _I2 = np.array([1, 2, 0]), np.array([2, 0, 1])
+
+
+def _cross(a, b):
+    """Cross product of (..., 3) arrays (cheaper than np.cross for small arrays)."""
+    return a[..., _I1] * b[..., _I2] - a[..., _I2] * b[..., _I1]
+
+
+class Track:
+    """Track centreline from segments, with cant and optional irregularities.
+
+    Parameters
+    ----------
+    segments : sequence of Straight, Curve, Transition
+    cant_base : float
+        Distance between the rail running circles used to turn cant height into an angle (m).
+    irregularities : Irregularities, optional
+    max_step : float
+        Largest interval of the internal piecewise-polynomial table (m).
+    origin : (3,) array_like, heading : float
+        Start point (m) and heading (rad) of the centreline.
+    """
+
+    def __init__(self, segments, cant_base=1.5, irregularities=None, max_step=2.0,
+                 origin=(0.0, 0.0, 0.0), heading=0.0):
+        segments = list(segments)
+        if not segments:
+            raise ValueError("track: at least one segment is needed")
+        for i, seg in enumerate(segments):
+            if not isinstance(seg, (Straight, Curve, Transition)):
+                raise ValueError(f"track: segment {i} is {seg!r}, not Straight/Curve/Transition")
+            if not (np.isfinite(seg.length) and seg.length > 0):
+                raise ValueError(f"track: segment {i} length {seg.length!r} must be positive")
+            if isinstance(seg, Curve):
+                if not (np.isfinite(seg.radius) and seg.radius != 0):
+                    raise ValueError(f"track: segment {i} radius {seg.radius!r} must be finite, non-zero")
+                if not (np.isfinite(seg.cant) and 0.0 <= seg.cant < cant_base):
+                    raise ValueError(f"track: segment {i} cant {seg.cant!r} m must be in [0, {cant_base})")
+        self.segments = segments
+        self.cant_base = float(cant_base)
+        self.irregularities = irregularities
+        # curvature and cant at segment ends
+        n = len(segments)
+        k_c = [1.0 / s.radius if isinstance(s, Curve) else 0.0 for s in segments]
+        p_c = [-np.sign(1.0 / s.radius) * np.arcsin(s.cant / cant_base) if isinstance(s, Curve)
+               else 0.0 for s in segments]
+        k0, k1, p0, p1 = (np.zeros(n) for _ in range(4))
+        for i, seg in enumerate(segments):
+            if isinstance(seg, Transition):
+                k0[i] = k_c[i - 1] if i > 0 and not isinstance(segments[i - 1], Transition) else 0.0
+                k1[i] = k_c[i + 1] if i + 1 < n and not isinstance(segments[i + 1], Transition) else 0.0
+                p0[i] = p_c[i - 1] if i > 0 and not isinstance(segments[i - 1], Transition) else 0.0
+                p1[i] = p_c[i + 1] if i + 1 < n and not isinstance(segments[i + 1], Transition) else 0.0
+            else:
+                k0[i] = k1[i] = k_c[i]
+                p0[i] = p1[i] = p_c[i]
+        L = np.array([s.length for s in segments], dtype=float)
+        s0 = np.concatenate([[0.0], np.cumsum(L)])
+        self.s_joints = s0
+        self.length = float(s0[-1])
+        psi0 = np.zeros(n)
+        psi0[0] = heading
+        for i in range(1, n):
+            psi0[i] = psi0[i - 1] + 0.5 * (k0[i - 1] + k1[i - 1]) * L[i - 1]
+        self._seg = dict(s0=s0[:-1], L=L, k0=k0, k1=k1, p0=p0, p1=p1, psi0=psi0)
+        # node grid: segment grids plus irregularity knots
+        nodes = [np.linspace(s0[i], s0[i + 1], max(2, int(np.ceil(L[i] / max_step)) + 1))
+                 for i in range(n)]
+        grid = np.unique(np.concatenate(nodes))
+        spline = None
+        if irregularities is not None:
+            from scipy.interpolate import CubicSpline
+
+            ir = irregularities
+            spline = CubicSpline(ir.s, np.column_stack([ir.lateral, ir.vertical]), bc_type="natural")
+            knots = ir.s[(ir.s > 0.0) & (ir.s < self.length)]
+            grid = np.unique(np.concatenate([grid, knots]))
+        self._spline = spline
+        self._build(grid, origin)
+
+    @classmethod
+    def straight(cls, length=1000.0, **kw):
+        """A straight track of ``length`` (m)."""
+        return cls([Straight(length)], **kw)
+
+    # -- segment formulas ---------------------------------------------------------------
+    def _seg_index(self, s, owner=None):
+        sj = self.s_joints
+        x = s if owner is None else owner
+        return np.clip(np.searchsorted(sj, x, side="right") - 1, 0, len(self.segments) - 1)
+
+    def _exact_heading(self, s, i):
+        g = self._seg
+        x = s - g["s0"][i]
+        dk = (g["k1"][i] - g["k0"][i]) / g["L"][i]
+        psi = g["psi0"][i] + g["k0"][i] * x + 0.5 * dk * x**2
+        kap = g["k0"][i] + dk * x
+        dp = (g["p1"][i] - g["p0"][i]) / g["L"][i]
+        phi = g["p0"][i] + dp * x
+        return psi, kap, dk + 0 * x, phi, dp + 0 * x
+
+    def _irr(self, s):
+        """(y_i, z_i) with first and second derivatives, zero outside the table."""
+        out = np.zeros((3, s.size, 2))
+        if self._spline is None:
+            return out
+        ir = self.irregularities
+        m = (s >= ir.s[0]) & (s <= ir.s[-1])
+        for k in range(3):
+            out[k, m] = self._spline(s[m], k)
+        return out
+
+    def _build(self, grid, origin):
+        a, b = grid[:-1], grid[1:]
+        mid = 0.5 * (a + b)
+        seg = self._seg_index(None, owner=mid)
+        h = b - a
+        # positions at nodes by Gauss-Legendre integration of (cos psi, sin psi) per interval
+        sq = mid[:, None] + 0.5 * h[:, None] * _GL_X[None, :]
+        psi_q = self._exact_heading(sq, seg[:, None])[0]
+        dX = 0.5 * h * (np.cos(psi_q) @ _GL_W)
+        dY = 0.5 * h * (np.sin(psi_q) @ _GL_W)
+        X = origin[0] + np.concatenate([[0.0], np.cumsum(dX)])
+        Y = origin[1] + np.concatenate([[0.0], np.cumsum(dY)])
+        self._z0 = float(origin[2])
+
+        def ends(sv, XY):
+            psi, kap, dk, phi, dp = self._exact_heading(sv, seg)
+            c, s_ = np.cos(psi), np.sin(psi)
+            f = np.column_stack([psi, phi, XY[0], XY[1]])
+            d1 = np.column_stack([kap, dp, c, s_])
+            d2 = np.column_stack([dk, 0 * dp, -kap * s_, kap * c])
+            return f, d1, d2
+
+        fa, da, dda = ends(a, (X[:-1], Y[:-1]))
+        fb, db, ddb = ends(b, (X[1:], Y[1:]))
+        ia, ib = self._irr(a), self._irr(b)
+        fa = np.column_stack([fa, ia[0]]); da = np.column_stack([da, ia[1]])
+        dda = np.column_stack([dda, ia[2]])
+        fb = np.column_stack([fb, ib[0]]); db = np.column_stack([db, ib[1]])
+        ddb = np.column_stack([ddb, ib[2]])
+        c = quintic_hermite_coeffs(h[:, None], fa, da, dda, fb, db, ddb)  # (n, 6 comps, 6)
+        self.pp = PiecewisePoly(grid, np.transpose(c, (0, 2, 1)))
+        # frame table for the contact search: r (3), R (9), omega (3) as quintic Hermite
+        # pieces from their exact values and first two derivatives at both ends of every
+        # interval, so that one evaluation gives r, r', r'', R, omega and omega'
+        idx = np.arange(h.size)
+        ends_ = []
+        for t in (np.zeros_like(h), h):
+            pos, dpos, ddpos, R, om, dom, ddom = self._assemble(self.pp.eval_piece(idx, t), True)
+            dR = _cross(om[:, None, :], np.swapaxes(R, 1, 2)).swapaxes(1, 2)
+            ddR = (_cross(dom[:, None, :], np.swapaxes(R, 1, 2))
+                   + _cross(om[:, None, :], np.swapaxes(dR, 1, 2))).swapaxes(1, 2)
+            n = h.size
+            ends_.append((np.column_stack([pos, R.reshape(n, 9), om]),
+                          np.column_stack([dpos, dR.reshape(n, 9), dom]),
+                          np.column_stack([ddpos, ddR.reshape(n, 9), ddom])))
+        (fa, da, dda), (fb, db, ddb) = ends_
+        c = quintic_hermite_coeffs(h[:, None], fa, da, dda, fb, db, ddb)
+        self.pp_frame = PiecewisePoly(grid, np.transpose(c, (0, 2, 1)))
+
+    # -- evaluation ---------------------------------------------------------------------
+    def evaluate(self, s) -> TrackFrame:
+        """Track frame and derivatives at arc lengths s (m), any 1-D array."""
+        s = np.atleast_1d(np.asarray(s, dtype=float)).reshape(-1)
+        if np.any(~np.isfinite(s)):
+            raise ValueError(f"track: non-finite arc length {s[~np.isfinite(s)][0]!r}")
+        return self._frame(s, second=True)
+
+    def _frame(self, s, second=False):
+        out = self._assemble(self.pp.eval_raw(s), False)
+        pos, dpos, ddpos, R, om, dom = out
+        if not second:
+            return pos, dpos, R, om
+        if second == "raw":
+            return pos, dpos, ddpos, R, om, dom
+        o = self.pp.eval_raw(s)
+        return TrackFrame(pos, dpos, ddpos, R, om, dom, o[:, 6], o[:, 1], o[:, 0])
+
+    def _frame_fast(self, s):
+        """(r, r', r'', R, omega, omega') from the frame table (one vectorised evaluation).
+
+        R is interpolated (quintic Hermite of its exact values and derivatives): orthonormal to
+        round-off for the interval lengths used (<= max_step).
+        """
+        o = self.pp_frame.eval_raw(s)
+        M = s.shape[0]
+        return (o[:, 0:3], o[:, 15:18], o[:, 30:33], o[:, 3:12].reshape(M, 3, 3), o[:, 12:15],
+                o[:, 27:30])
+
+    def _assemble(self, o, third):
+        """Frame quantities from raw (value, d1, d2) rows of the base table."""
+        psi, phi, X, Y, yi, zi = o[:, 0], o[:, 1], o[:, 2], o[:, 3], o[:, 4], o[:, 5]
+        kap, dphi, dX, dY, dyi, dzi = (o[:, 6 + k] for k in range(6))
+        dkap, ddphi, ddX, ddY, ddyi, ddzi = (o[:, 12 + k] for k in range(6))
+        cp, sp, cf, sf = np.cos(psi), np.sin(psi), np.cos(phi), np.sin(phi)
+        z = np.zeros_like(psi)
+        t = np.stack([cp, sp, z], axis=1)
+        n = np.stack([-sp * cf, cp * cf, sf], axis=1)
+        bb = np.stack([sp * sf, -cp * sf, cf], axis=1)
+        R = np.stack([t, n, bb], axis=2)
+        om = np.stack([dphi * cp, dphi * sp, kap], axis=1)
+        off = yi[:, None] * n + zi[:, None] * bb
+        pos = np.stack([X, Y, z + self._z0], axis=1) + off
+        doff_local = dyi[:, None] * n + dzi[:, None] * bb
+        dpos = np.stack([dX, dY, z], axis=1) + doff_local + _cross(om, off)
+        dom = np.stack([ddphi * cp - dphi * sp * kap, ddphi * sp + dphi * cp * kap, dkap], axis=1)
+        ddpos = (np.stack([ddX, ddY, z], axis=1) + ddyi[:, None] * n + ddzi[:, None] * bb
+                 + 2.0 * _cross(om, doff_local) + _cross(dom, off)
+                 + _cross(om, _cross(om, off)))
+        if not third:
+            return pos, dpos, ddpos, R, om, dom
+        # second derivative of omega; phi and kappa are linear in s inside a segment
+        ddom = np.stack([-2 * ddphi * sp * kap - dphi * (cp * kap**2 + sp * dkap),
+                         2 * ddphi * cp * kap + dphi * (-sp * kap**2 + cp * dkap), z], axis=1)
+        return pos, dpos, ddpos, R, om, dom, ddom
+
+
+def parse_inclination(value):
+    """Rail inclination as tan(alpha) >= 0 from 0.025, "1:40", "1:20" or "vertical".
+
+    A negative value (rail tilted away from the track centre) is rejected.
+    """
+    if isinstance(value, str):
+        v = value.strip().lower()
+        if v in ("vertical", "0", "none"):
+            return 0.0
+        if ":" in v:
+            num, den = v.split(":", 1)
+            try:
+                value = float(num) / float(den)
+            except (ValueError, ZeroDivisionError):
+                raise ValueError(f"rail inclination {value!r}: expected e.g. '1:40'") from None
+        else:
+            try:
+                value = float(v)
+            except ValueError:
+                raise ValueError(f"rail inclination {value!r}: expected e.g. '1:40', 0.025 or 'vertical'") from None
+    value = float(value)
+    if not np.isfinite(value):
+        raise ValueError(f"rail inclination {value!r} is not finite")
+    if value < 0.0:
+        raise ValueError(
+            f"rail inclination {value!r} is negative: rails are inclined towards the track "
+            f"centre, give tan(alpha) >= 0 (e.g. 1/40 = 0.025)")
+    if value > 0.2:
+        raise ValueError(f"rail inclination {value!r} is implausibly large (tan alpha > 0.2)")
+    return value
+
+
+class RailMounting:
+    """A rail profile inclined towards the track centre and placed at the given gauge.
+
+    Parameters
+    ----------
+    profile : RailProfile, optional
+        Default UIC60.
+    gauge : float
+        Track gauge (m) between the gauge points, default 1.435.
+    inclination : float or str
+        tan(alpha) towards the track centre (1/40 default, "1:20", "vertical").
+    gauge_depth : float
+        Depth of the gauge point below the top of rail (m), default 0.014.
+
+    Attributes
+    ----------
+    Y0, Z0 : float
+        Offsets of the profile origin (rail axis at the crown) in (Yo, Z) (m).
+    u_min, u_max : float
+        Profile range usable for contact (the mounted profile is a graph over Yo there).
+    u_gauge : float
+        Profile coordinate of the gauge point.
+    """
+
+    def __init__(self, profile=None, gauge=1.435, inclination=1 / 40, gauge_depth=0.014):
+        self.profile = profile if profile is not None else RailProfile.uic60()
+        for key, val in (("gauge", gauge), ("gauge_depth", gauge_depth)):
+            if not np.isfinite(val) or val <= 0:
+                raise ValueError(f"rail mounting: {key} = {val!r} must be positive and finite")
+        self.gauge = float(gauge)
+        self.inclination = parse_inclination(inclination)
+        self.gauge_depth = float(gauge_depth)
+        al = np.arctan(self.inclination)
+        self.ca, self.sa = float(np.cos(al)), float(np.sin(al))
+        p = self.profile
+        u = np.linspace(p.x_min, p.x_max, 20001)
+        v, v1, _ = p.evaluate(u)
+        a1 = self.ca - v1 * self.sa
+        ok = a1 > 0.02  # mounted profile a graph over Yo (slope below ~50)
+        i0 = int(np.argmin(np.abs(u)))
+        lo = i0
+        while lo > 0 and ok[lo - 1]:
+            lo -= 1
+        hi = i0
+        while hi < u.size - 1 and ok[hi + 1]:
+            hi += 1
+        self.u_min, self.u_max = float(u[lo]), float(u[hi])
+        Yo = u * self.ca - v * self.sa
+        Z = u * self.sa + v * self.ca
+        i_top = int(np.argmax(Z))
+        # refine the top (dZ/du = 0) and the gauge point (Z = Z_top - depth on the gauge side)
+        ut = self._newton(u[i_top], lambda x: self._mounted(x)[3], lambda x: self._mounted(x)[5])
+        z_top = self._mounted(ut)[1]
+        target = z_top - self.gauge_depth
+        m = (u < ut) & (u >= self.u_min)
+        j = np.nonzero(m & (Z <= target))[0]
+        if j.size == 0:
+            raise ValueError(f"rail mounting: the profile {p.name} does not reach {gauge_depth} m "
+                             f"below its top on the gauge side")
+        ug0 = u[j[-1]]
+        ug = self._newton(ug0, lambda x: self._mounted(x)[1] - target,
+                          lambda x: self._mounted(x)[3])
+        self.u_top, self.u_gauge = float(ut), float(ug)
+        yo_g = self._mounted(ug)[0]
+        self.Y0 = 0.5 * self.gauge - yo_g
+        self.Z0 = -z_top
+
+    def _mounted(self, u):
+        u = np.asarray(u, dtype=float)
+        v, v1, v2 = self.profile.poly(u)
+        ca, sa = self.ca, self.sa
+        return (u * ca - v * sa, u * sa + v * ca, ca - v1 * sa, sa + v1 * ca, -v2 * sa, v2 * ca)
+
+    @staticmethod
+    def _newton(x, f, df, n=30):
+        x = float(x)
+        for _ in range(n):
+            dx = float(f(x)) / float(df(x))
+            x -= dx
+            if abs(dx) < 1e-15:
+                break
+        return x
+
+    def mounted(self, u):
+        """Mounted profile (Yo, Z, dYo/du, dZ/du, d2Yo/du2, d2Z/du2) at u (m), in the track
+        frame's outward lateral coordinate and height."""
+        Yo, Z, a1, b1, a2, b2 = self._mounted(u)
+        return Yo + self.Y0, Z + self.Z0, a1, b1, a2, b2
+
+    def lateral_to_u(self, yo):
+        """Profile coordinate u at outward lateral position yo (m) on the running surface."""
+        u = np.linspace(self.u_min, self.u_max, 4001)
+        Yo = self.mounted(u)[0]
+        return np.interp(yo, Yo, u)

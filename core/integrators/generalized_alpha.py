@@ -375,9 +375,18 @@ class GeneralizedAlpha(Integrator):
             vd += bp * dx
             a1 += dx / bh2
             v1 += gp * dx
-            lam += d[nv:] / bh2
+            dlam = d[nv:] / bh2
+            lam += dlam
             eq, ev = dx * wq, dx * wv
             dnorm = np.sqrt(max(eq @ eq, gp * gp * (ev @ ev)) / nv) if nv else 0.0
+            # the multipliers must converge too: with a reused iteration matrix the position
+            # increments can be tiny while λ is still far off (e.g. massless rotations, where λ
+            # alone balances the equations); measure δλ against the force level of the step
+            if len(dlam):
+                f_scale = max(float(np.max(np.abs(lam))), float(np.max(np.abs(Qv))) if nv else 0.0, 1e-300)
+                # relative floor 1e-8: λ comes out of the scaled KKT solve as d/(βh²), whose
+                # round-off (~eps·cond) would otherwise stall Newton at very tight rtol
+                dnorm = max(dnorm, float(np.max(np.abs(dlam))) / (max(self.rtol, 1e-8) * f_scale + self.atol))
             if not np.isfinite(dnorm):
                 return False, f"Newton iteration diverged (non-finite increment) at t = {t1:.6g} s"
             if norm_old is None:

@@ -24,15 +24,31 @@ Wanner II, Sec. VII.4, Table 4.1).  Implementation as in RADAU5 (Hairer & Wanner
 simplified Newton with the Jacobian frozen at the step start and ``A⁻¹`` transformed to one
 real and one complex block, i.e. one real and one complex sparse LU of
 ``(μ/h) 𝓜 − ∂F/∂y``; the Jacobian contains ``Q_q, Q_v`` (``system.Q_jacobians``), the
-constraint-force stiffness ``(Φ_qᵀλ)_q`` and the curvature ``(Φ_q v)_q`` (sparse coloured finite
-differences, :class:`core.integrators.generalized_alpha.ConstraintCurvature`).
+constraint-force stiffness ``(Φ_qᵀλ)_q`` and the curvature ``(Φ_q v)_q − ν_q`` (sparse coloured
+finite differences, :class:`core.integrators.generalized_alpha.ConstraintCurvature`; ``ν_q ≠ 0``
+for moving constraints) and, when ``M = M(q)``, the term ``−(M(q) v̇)_q``.
+
+Configuration-dependent mass matrix: the collocation conditions are
+``M(t_i, Y_i) Ẏ_i = F(t_i, Y_i)`` at each stage, ``Ẏ = (A⁻¹ ⊗ I) Z / h`` (the Radau IIA solution
+of the equivalent index-1 system ``ẏ = w, 0 = 𝓜(y) w − F``); only the iteration matrix uses
+``M(t_n, q_n)``.  The Newton residual is therefore the constant-𝓜 one of RADAU5 plus the stage
+corrections ``−(M(t_i, q_i) − M(t_n, q_n)) v̇_i``.  (Freezing ``M`` at the step start in the
+residual too solves a different, first-order-accurate problem that the embedded error estimate
+cannot see.)
+
+Newton convergence is measured on ``(X, v)`` with the error weights, floored at
+``10 ε ‖block‖_∞ / κ`` (``κ`` the Newton tolerance) per block: the constraint rows mix fast and
+slow coordinates, so corrections of slow ones carry rounding errors ``~ε ‖v‖_∞`` that a purely
+component-wise weight ``atol + rtol |v_i|`` cannot resolve at tight tolerances.
 Error estimate: the embedded RADAU5 estimate
 ``err = (γ₀/h 𝓜 − J)⁻¹ (F(t_n, y_n) + 𝓜 Σ e_i Z_i / h)`` (Hairer & Wanner II, Eq. IV.8.20),
 with the norm taken over the differential components ``(X, v)`` only — the index-2
 components ``λ, μ`` are excluded as Hairer & Wanner recommend for index-2 problems
 (Sec. VII.4, "the error estimate").  Step-size selection: the predictive (Gustafsson)
-controller of RADAU5 (Eq. IV.8.25), Jacobian reuse and initial Newton guesses from the
-previous collocation polynomial as in ``scipy.integrate.Radau``.  Multipliers are the last
+controller of RADAU5 (Eq. IV.8.25), no step increase directly after a rejected attempt
+(error test or Newton failure, as RADAU5), Jacobian reuse and initial Newton guesses from the
+previous collocation polynomial as in ``scipy.integrate.Radau``.  Unlike RADAU5, the user's
+``rtol`` is used as given (RADAU5 internally replaces it by ``0.1 rtol^(2/3)``).  Multipliers are the last
 stage's ``λ`` (stiffly accurate), so ``provides_multipliers`` is True.  Dense output: the
 collocation polynomial (order 3), mapped through ``⊕``.
 
@@ -75,6 +91,9 @@ P = np.array([
     [13 / 3 + 7 * S6 / 3, -23 / 3 - 22 * S6 / 3, 10 / 3 + 5 * S6],
     [13 / 3 - 7 * S6 / 3, -23 / 3 + 22 * S6 / 3, 10 / 3 - 5 * S6],
     [1 / 3, -8 / 3, 10 / 3]])
+#: Radau IIA coefficient matrix inverse, ``A⁻¹`` (stage derivatives ``Ẏ_i = (A⁻¹ Z)_i / h``).
+A_INV = T @ np.array([[MU_REAL, 0, 0], [0, MU_COMPLEX.real, -MU_COMPLEX.imag],
+                      [0, MU_COMPLEX.imag, MU_COMPLEX.real]]) @ TI
 NEWTON_MAXITER = 6
 MIN_FACTOR, MAX_FACTOR = 0.2, 10.0
 
@@ -129,6 +148,9 @@ class RadauGGL(Integrator):
         self.lam = lam0
         self.mu = np.zeros(nc)
         self._curv = ConstraintCurvature(sys_, self.t, self.q) if nc else None
+        # ν may depend on q only for moving (time-dependent) constraints
+        self._rheonomic = bool(nc) and not (getattr(sys_, "time_dependent", None) is False
+                                            and not getattr(sys_, "user_constraints", None))
         rtol = self.rtol
         self.newton_tol = max(10 * np.finfo(float).eps / rtol, min(0.03, rtol ** 0.5))
         f0 = np.concatenate([self.v, a0])
@@ -152,7 +174,11 @@ class RadauGGL(Integrator):
     # --- model pieces -----------------------------------------------------------------------
     def _Mbig(self, t, q):
         nv, nc = self.nv, self.nc
-        M = self._M_const if self._M_const is not None else _sparse(self.system.M(t, q))
+        if self._M_const is not None:
+            M = self._M_const
+        else:
+            self._Mn = np.asarray(self.system.M(t, q), float)
+            M = _sparse(self._Mn)
         return sp.block_diag([sp.identity(nv, format="csr"), M, sp.csr_matrix((2 * nc, 2 * nc))], format="csc")
 
     def _F(self, t, qn, y):
@@ -177,10 +203,18 @@ class RadauGGL(Integrator):
         _, J, _, _ = constraint_terms(sys_, t, q, v)
         J = _sparse(J)
         Kq, Kv = q_jacobians(sys_, t, q, v)
+        if self._M_const is None and self.a is not None:
+            # configuration-dependent mass: the residual Q − Φ_qᵀλ − M(q) v̇ also varies with q
+            # through −(M(q) v̇)_q (large for fast mechanisms, e.g. Andrews' squeezer)
+            Kq = Kq - sp.csr_matrix(self._mass_stiffness(t, q, self.a))
         I = sp.identity(nv, format="csr")
         if nc:
             GL, GW = self._curv(t, q, J, lam, v)
             self.counters["n_rhs"] += self._curv.n_colors
+            if self._rheonomic:
+                # ∂(Φ_q v − ν)/∂q = (Φ_q v)_q − ν_q: ν = −Φ_t depends on q for moving
+                # constraints (car axis: wheel contact on the moving road point)
+                GW = GW - self._nu_q(t, q)
             GM, _ = self._curv(t, q, J, mu, v) if np.any(mu) else (None, None)
             A_XX = GM if GM is not None else None
             if self.nb_rot:
@@ -199,8 +233,48 @@ class RadauGGL(Integrator):
         self.counters["n_jac"] += 1
         return jac
 
-    def _scale_d(self, q, v):
-        return self.atol + self.rtol * np.concatenate([q_magnitude(self.system, q), np.abs(v)])
+    def _nu_q(self, t, q, eps=1e-7):
+        """``∂ν(t, q ⊕ X)/∂X`` at ``X = 0`` (sparse, pattern of ``Φ_q``; coloured differences)."""
+        sys_, curv = self.system, self._curv
+        nu0 = np.asarray(sys_.nu(t, q), float)
+        D = np.empty((curv.n_colors, self.nc))
+        for c, g in enumerate(curv.groups):
+            dv = np.zeros(self.nv)
+            dv[g] = eps
+            D[c] = (np.asarray(sys_.nu(t, sys_.retract(q, dv)), float) - nu0) / eps
+        self.counters["n_rhs"] += curv.n_colors
+        r, c = curv.J_rows, curv.J_cols
+        return sp.csr_matrix((D[curv.color[c], r], (r, c)), shape=curv.shape_J)
+
+    def _mass_stiffness(self, t, q, a, eps=1e-7):
+        """``∂(M(t, q ⊕ X) a)/∂X`` at ``X = 0`` by forward differences, shape (n_v, n_v)."""
+        sys_ = self.system
+        nv = self.nv
+        Ma = np.asarray(sys_.M(t, q), float) @ a
+        D = np.empty((nv, nv))
+        for k in range(nv):  # Jacobian evaluations only, for systems with a non-constant M
+            dv = np.zeros(nv)
+            h = eps * max(1.0, abs(q[k]) if sys_.n_q == nv else 1.0)
+            dv[k] = h
+            D[:, k] = (np.asarray(sys_.M(t, sys_.retract(q, dv)), float) @ a - Ma) / h
+        self.counters["n_rhs"] += nv
+        return D
+
+    def _newton_scale(self, q, v):
+        """Weights of the Newton increments: the error weights, floored at the rounding level.
+
+        The corrections of all components of a block (positions, velocities) carry rounding
+        errors of about ``ε ‖block‖_∞`` (the constraint rows mix all of them: ``Φ_q v`` of a
+        mechanism with one fast and several slow members).  A weight below
+        ``10 ε ‖block‖_∞ / newton_tol`` would ask the iteration to resolve increments below that
+        noise, and it could never converge (rate ≈ 1 for any step size).
+        """
+        qm = q_magnitude(self.system, q)
+        scale = self.atol + self.rtol * np.concatenate([qm, np.abs(v)])
+        floor = 10 * np.finfo(float).eps / self.newton_tol
+        scale[:self.nv] = np.maximum(scale[:self.nv], floor * np.max(qm, initial=0.0))
+        scale[self.nv:] = np.maximum(scale[self.nv:], floor * np.max(np.abs(v), initial=0.0))
+        return scale
 
     # --- collocation ------------------------------------------------------------------------
     def _solve_collocation(self, t, qn, y, h, Z0, scale, Mbig):
@@ -219,6 +293,14 @@ class RadauGGL(Integrator):
         for k in range(NEWTON_MAXITER):
             for i in range(3):
                 F[i] = self._F(t + ch[i], qn, y + Z[i])
+            if self._M_const is None:
+                # collocation of M(q) v̇ = …  at the stages: the residual needs M(t_i, Y_i), the
+                # iteration matrix keeps M(t_n, q_n) (absorbed in the W-form term below)
+                Vd = (A_INV @ Z[:, self.nv:nd]) / h
+                Mn = self._Mn
+                for i in range(3):
+                    qi = self.system.retract(qn, Z[i, :self.nv])
+                    F[i, self.nv:nd] -= (self.system.M(t + ch[i], qi) - Mn) @ Vd[i]
             if not np.all(np.isfinite(F)):
                 break
             f_real = F.T.dot(TI_REAL) - M_real * (Mbig @ W[0])
@@ -286,7 +368,7 @@ class RadauGGL(Integrator):
                 x1 = (t - t_old_base) / h_old
                 y1 = Qp @ np.array([x1, x1 ** 2, x1 ** 3])
                 Z0 = Yp - y1
-            scale = self._scale_d(qn, self.v)
+            scale = self._newton_scale(qn, self.v)
             converged = False
             while not converged:
                 if self.LU_real is None:
@@ -302,6 +384,7 @@ class RadauGGL(Integrator):
                 self.counters["n_rejected"] += 1
                 h_abs *= 0.5
                 self.LU_real = None
+                rejected = True
                 msg = f"Newton iteration did not converge (h = {h:.3g} s, rate {rate})"
                 continue
             y_new = y + Z[-1]
@@ -330,6 +413,11 @@ class RadauGGL(Integrator):
         recompute_jac = self._jac is not None and n_iter > 2 and rate is not None and rate > 1e-3
         factor = self._predict_factor(h_abs, error_norm)
         factor = min(MAX_FACTOR, safety * factor)
+        if rejected:
+            # RADAU5: no increase right after a rejection (error test or Newton failure); else
+            # a step limited by Newton convergence (kinematically driven systems, whose error
+            # estimate is ≈ 0) grows tenfold and fails again at every other step
+            factor = min(1.0, factor)
         if not recompute_jac and factor < 1.2:
             factor = 1
         else:

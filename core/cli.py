@@ -5,6 +5,8 @@ Commands::
     mbsuite list                              scenes with their titles
     mbsuite run NAME [NAME ...] [-o OUT] [--fast]
     mbsuite run --all [-o OUT] [--fast]       every scene, into OUT/<scene name>/
+    mbsuite bench [PROBLEM ...] [--methods M ...] [--repeats N] [--quick|--full] [-j N] [-o OUT]
+    mbsuite bench --list                      work-precision problems and methods (core.workprecision)
     mbsuite --version
 
 Domain packages add sub-commands through entry points in group
@@ -127,6 +129,10 @@ def build_parser() -> argparse.ArgumentParser:
     p_run.add_argument("-o", "--out", default="out", help="output folder (default: %(default)s)")
     p_run.add_argument("--fast", action="store_true", help="reduced resolution (smoke test)")
     p_run.set_defaults(func=_cmd_run, _parser=p_run)
+
+    from .workprecision import register_bench_command
+
+    register_bench_command(sub)
 
     for ep in _command_entry_points():
         try:

@@ -723,3 +723,368 @@ def bouncing_ball(radius: float = 0.1, mass: float = 1.0, height0: float = 1.0, 
                              impact_velocity=np.sqrt(2 * g * h0), stiffness=stiffness, exponent=exponent,
                              model=model))
     return b.build()
+
+
+# --------------------------------------------------------------------------------------------
+# Andrews' squeezing mechanism as a Cartesian planar model (IFToMM A03 / test set "andrews")
+# --------------------------------------------------------------------------------------------
+
+
+def _andrews_points(q_angles, p):
+    r"""Joint points, spring point D and body frames of Andrews' mechanism from the seven angles.
+
+    Returns ``(points, frames)``: ``points`` maps a point name to its global position [m];
+    ``frames`` is a list of ``(body name, orientation [rad], centre of mass [m])`` for bodies 1..7.
+    """
+    b, th, g, ph, de, om, ep = (float(x) for x in q_angles)
+    e_ = lambda a: np.array([np.cos(a), np.sin(a)])  # noqa: E731
+    rot = lambda a, v: np.array([np.cos(a) * v[0] - np.sin(a) * v[1], np.sin(a) * v[0] + np.cos(a) * v[1]])  # noqa: E731
+    O = np.zeros(2)
+    A = np.array([p["xa"], p["ya"]])
+    B = np.array([p["xb"], p["yb"]])
+    C = np.array([p["xc"], p["yc"]])
+    F = p["rr"] * e_(b)
+    E = F - p["d"] * e_(b + th)
+    G = A + p["zt"] * e_(de)
+    H = A + rot(ep, (0.0, -p["u"]))
+    D = B + rot(g, (p["sd"], -p["sc"]))
+    ee, zz = p["e"] - p["ea"], p["zf"] - p["fa"]
+    frames_ = [
+        ("body1", b, p["ra"] * e_(b)),
+        ("body2", b + th, F - p["da"] * e_(b + th)),
+        ("body3", g, B + rot(g, (p["sa"], p["sb"]))),
+        ("body4", ph + de, G + rot(ph + de, (0.0, -ee))),
+        ("body5", de, A + rot(de, (p["ta"], p["tb"]))),
+        ("body6", om + ep, H + zz * e_(om + ep)),
+        ("body7", ep, A + rot(ep, (p["ua"], p["ub"]))),
+    ]
+    return dict(O=O, A=A, B=B, C=C, D=D, E=E, F=F, G=G, H=H), frames_
+
+
+def andrews_cartesian(**overrides: float) -> Model:
+    r"""Andrews' squeezing mechanism as a planar Cartesian model of seven rigid bodies.
+
+    The same mechanism as :class:`core.benchmark_problems.AndrewsSqueezer` (which is written in
+    the seven angles), built with :class:`~core.model.ModelBuilder` in absolute coordinates
+    ``(x, y, θ)`` per body: 21 coordinates, ten revolute joints (20 equations), 1 degree of
+    freedom.  Its solution must reach the same angles (:func:`andrews_angles_from_cartesian`).
+
+    Geometry (Hairer & Wanner II, Sec. VII.7, Fig. 7.1 and Eqs. (7.11)–(7.14); test set
+    ``andrews.f``), read off the angle-form constraints and mass matrix of
+    :class:`~core.benchmark_problems.AndrewsSqueezer`; ``e(α) = (cos α, sin α)``,
+    ``R(α)`` the rotation by α; fixed points O = (0, 0), A = (xa, ya), B = (xb, yb),
+    C = (xc, yc):
+
+    ====== ========== ===================================================================
+    body   angle θ    joints, centre of mass
+    ====== ========== ===================================================================
+    1      β          crank: pivot O; F = rr e(β); c.o.m. at ra e(β)
+    2      β + Θ      coupler: F; E = F − d e(β+Θ); c.o.m. at F − da e(β+Θ)
+    3      γ          pivot B; E = B + R(γ)(0, −ss); spring point D = B + R(γ)(sd, −sc);
+                      c.o.m. at B + R(γ)(sa, sb)
+    4      Φ + δ      G; E = G + R(Φ+δ)(0, −e); c.o.m. at G + R(Φ+δ)(0, −(e − ea))
+    5      δ          pivot A; G = A + zt e(δ); c.o.m. at A + R(δ)(ta, tb)
+    6      Ω + ε      H; E = H + zf e(Ω+ε); c.o.m. at H + (zf − fa) e(Ω+ε)
+    7      ε          pivot A; H = A + R(ε)(0, −u); c.o.m. at A + R(ε)(ua, ub)
+    ====== ========== ===================================================================
+
+    Joints (revolute): ``O`` (ground–1), ``F`` (1–2), ``B`` (ground–3), ``E23``, ``E24``,
+    ``E26`` (body 2 to bodies 3, 4, 6 at the common point E), ``A5`` (ground–5), ``G``
+    (5–4), ``A7`` (ground–7), ``H`` (7–6).  Force elements: the spring ``spring c0`` between
+    D on body 3 and C on the ground, stiffness c0 = 4530 N/m, free length l0 = 0.07785 m
+    (:class:`core.forces.SpringDamper`); the drive torque ``drive mom`` = 0.033 N m on body 1
+    (:class:`core.forces.AppliedTorque`).  No gravity.
+
+    Assumption (stated, and without effect on the motion): the published data give for the
+    bodies pivoted at a fixed point (1, 3, 5, 7) only the *distance* of the centre of mass from
+    the pivot (``ra``, ``√(sa² + sb²)``, ``√(ta² + tb²)``, ``√(ua² + ub²)``, which is all the
+    angle-form mass matrix contains); the direction chosen above changes no equation of motion
+    (no gravity acts, and a body turning about a fixed pivot has kinetic energy
+    ``½ (I + m s²) θ̇²`` whatever the direction of s).  For bodies 2, 4 and 6 the centre of mass
+    lies on the line of the two joints, as the cross terms ``M21``, ``M54``, ``M76`` require.
+
+    Initial state: positions from the published consistent angles
+    (:attr:`AndrewsSqueezer.Q0_PUBLISHED`), all velocities zero.
+
+    Parameters
+    ----------
+    **overrides : float
+        Replace entries of :data:`core.benchmark_problems.ANDREWS_PARAMETERS` (SI units).
+
+    Returns
+    -------
+    Model
+        Bodies ``body1..body7``.
+
+    References
+    ----------
+    E. Hairer, G. Wanner, *Solving ODEs II*, 2nd ed., Springer, 1996, Sec. VII.7, pp. 530–536.
+    F. Mazzia, C. Magherini, *Test Set for IVP Solvers* 2.4, Univ. of Bari, 2008, "andrews".
+    W. Schiehlen (ed.), *Multibody Systems Handbook*, Springer, 1990 (Manning & Giles,
+    Andrews & Richard: "seven body mechanism"); IFToMM benchmark A03.
+    """
+    from .benchmark_problems import ANDREWS_PARAMETERS, AndrewsSqueezer
+    from .forces import AppliedTorque, SpringDamper
+
+    unknown = set(overrides) - set(ANDREWS_PARAMETERS)
+    if unknown:
+        raise ValueError(f"andrews_cartesian: unknown parameter(s) {sorted(unknown)}")
+    p = dict(ANDREWS_PARAMETERS, **{k: float(v) for k, v in overrides.items()})
+    pts, frames_ = _andrews_points(AndrewsSqueezer.Q0_PUBLISHED, p)
+    b = ModelBuilder(2, "andrews_cartesian", gravity=(0.0, 0.0))
+    for k, (name, ang, com) in enumerate(frames_):
+        b.add_body(name, p[f"m{k + 1}"], p[f"i{k + 1}"], com, orientation=ang)
+    for jname, bi, bj, at in (("O", "ground", "body1", "O"), ("F", "body1", "body2", "F"),
+                              ("B", "ground", "body3", "B"), ("E23", "body2", "body3", "E"),
+                              ("E24", "body2", "body4", "E"), ("E26", "body2", "body6", "E"),
+                              ("A5", "ground", "body5", "A"), ("G", "body5", "body4", "G"),
+                              ("A7", "ground", "body7", "A"), ("H", "body7", "body6", "H")):
+        b.add_revolute(jname, bi, bj, pts[at])
+    b.add_force(SpringDamper("spring c0", "body3", "ground", pts["D"], pts["C"], p["c0"], 0.0, p["l0"]))
+    b.add_force(AppliedTorque("drive mom", "body1", p["mom"]))
+    return b.build()
+
+
+def andrews_angles_from_cartesian(model: Model, q: Array) -> Array:
+    r"""The seven angles ``(β, Θ, γ, Φ, δ, Ω, ε)`` [rad] of :func:`andrews_cartesian` states.
+
+    ``β = θ1``, ``Θ = θ2 − θ1``, ``γ = θ3``, ``Φ = θ4 − θ5``, ``δ = θ5``, ``Ω = θ6 − θ7``,
+    ``ε = θ7`` with ``θ_k`` the (unwrapped) body angles.  The same linear map applies to
+    velocities and accelerations (pass ``v`` or ``a`` in place of ``q``).
+
+    Parameters
+    ----------
+    model : Model
+        Built by :func:`andrews_cartesian`.
+    q : ndarray, shape (21,) or (n_t, 21)
+
+    Returns
+    -------
+    ndarray, shape (7,) or (n_t, 7)
+    """
+    q = np.asarray(q, float)
+    if q.shape[-1] != model.n_v or model.n_bodies != 7:
+        raise ValueError(f"andrews_angles_from_cartesian: expected a 7-body planar state of length 21, got {q.shape}")
+    th = q[..., 2::3]
+    return np.stack([th[..., 0], th[..., 1] - th[..., 0], th[..., 2], th[..., 3] - th[..., 4], th[..., 4],
+                     th[..., 5] - th[..., 6], th[..., 6]], axis=-1)
+
+
+# --------------------------------------------------------------------------------------------
+# IFToMM A02: N four-bar mechanism
+# --------------------------------------------------------------------------------------------
+
+
+def _a02_rate(phi: float, speed: float, L: float) -> float:
+    """Bar rate φ̇ [rad/s] giving ẋ(B_0) = −L φ̇ sin φ = speed (or ẏ(B_0) = speed when sin φ = 0)."""
+    if abs(np.sin(phi)) > 1e-12:
+        return -speed / (L * np.sin(phi))
+    return speed / (L * np.cos(phi))
+
+
+def iftomm_a02_four_bar_chain(n_windows: int = 40, link_length: float = 1.0, link_mass: float = 1.0,
+                              speed: float = 1.0, angle0: float = np.pi / 2, gravity: float = G_EARTH,
+                              redundant: str = "keep") -> Model:
+    r"""IFToMM benchmark A02: the N four-bar mechanism (a row of N parallelogram "windows").
+
+    Geometry (IFToMM library, González et al. 2006; as implemented in the open OpenSim port of
+    the library, RehabEngGroup/MBSbenchmarksInOpenSim, ``src/A02-NFourBarMechanism``): ground
+    pivots ``O_i = (i L, 0)``, i = 0..N; ``N + 1`` *bars* ``bar0..barN``, bar i from ``O_i`` to
+    ``B_i = O_i + L e(φ)``; ``N`` *couplers* ``coupler1..couplerN``, coupler i from
+    ``B_{i−1}`` to ``B_i``: ``2N + 1`` uniform slender links of length L = 1 m, mass 1 kg,
+    ``J = m L²/12``; gravity 9.81 m/s² along −y.  Revolute joints ``O_i`` (ground–bar i),
+    ``B_0`` (bar0–coupler1), ``B_i/L`` (coupler i–bar i) and ``B_i/R`` (bar i–coupler i+1),
+    ``B_N`` (couplerN–barN).  Initial configuration: bars vertical (φ = π/2), couplers horizontal
+    at y = L; initial velocity ``ẋ(B_0) = 1 m/s``, i.e. every bar turns at ``φ̇ = −ẋ(B_0)/L``
+    (clockwise) and every coupler translates at (1, 0) m/s.  Simulated for 20 s.
+
+    Motion: the parallelograms keep all bars parallel, so the exact motion is that of one
+    equivalent pendulum in the bar angle φ (:func:`iftomm_a02_reference`)::
+
+        [ (N+1) m L²/3 + N m L² ] φ̈ = −g L cos φ [ (N+1) m/2 + N m ]
+
+    Starting upright with non-zero speed the bars circulate, passing through the horizontal
+    positions φ = 0, π where all links are collinear on the ground line: there ``Φ_q`` loses
+    N ranks and the mechanism has N + 1 degrees of freedom instead of 1 (the singular
+    configurations of the benchmark).
+
+    Redundancy: at the upright start (and at every non-horizontal configuration) the 2(3N+1)
+    revolute equations are independent: Grübler count ``3(2N+1) − 2(3N+1) = 1`` equals the
+    mobility, so ``build`` reports *no* redundant equations there (``redundant`` only matters
+    when ``angle0`` is a singular angle, 0 or π; the default ``'keep'`` then keeps the
+    dependent rows and the integrators use minimum-norm multipliers).
+
+    Parameters
+    ----------
+    n_windows : int
+        N ≥ 1 (40 in the benchmark).
+    link_length, link_mass : float
+        L [m], m [kg].
+    speed : float
+        ẋ(B_0) at t = 0 [m/s] (``φ̇(0) = −speed/(L sin φ0)``); when ``angle0`` is horizontal
+        (sin φ0 = 0, where ẋ(B_0) must vanish) it is ẏ(B_0) instead.
+    angle0 : float
+        Initial bar angle φ from +x [rad] (π/2: upright, the benchmark).
+    gravity : float
+        [m/s²] along −y.
+    redundant : {'raise', 'remove', 'keep'}
+        Passed to :meth:`ModelBuilder.build`.
+
+    Returns
+    -------
+    Model
+        Bodies ``bar0..barN``, ``coupler1..couplerN``.
+
+    References
+    ----------
+    M. González, D. Dopico, U. Lugrís, J. Cuadrado, Multibody Syst. Dyn. 16 (2006) 179–190;
+    IFToMM Library of Computational Benchmark Problems, problem A02 "N four-bar mechanism";
+    E. Bayo, R. Ledesma (1996) / Bayo & Avello (1994) (the two-window original).
+    """
+    if isinstance(n_windows, bool) or not isinstance(n_windows, (int, np.integer)) or n_windows < 1:
+        raise ValueError(f"iftomm_a02_four_bar_chain: n_windows must be an integer ≥ 1, got {n_windows!r}")
+    L = _check_positive("iftomm_a02_four_bar_chain: link_length", link_length)
+    m = _check_positive("iftomm_a02_four_bar_chain: link_mass", link_mass)
+    phi = float(angle0)
+    w = _a02_rate(phi, float(speed), L)
+    e = np.array([np.cos(phi), np.sin(phi)])
+    eperp = np.array([-e[1], e[0]])
+    J = m * L * L / 12.0
+    b = ModelBuilder(2, f"iftomm_a02_{n_windows}", gravity=(0.0, -gravity))
+    vB = L * w * eperp
+    for i in range(n_windows + 1):
+        O = np.array([i * L, 0.0])
+        b.add_body(f"bar{i}", m, J, O + 0.5 * L * e, orientation=phi, velocity=0.5 * vB, angular_velocity=w)
+    for i in range(1, n_windows + 1):
+        Bl = np.array([(i - 1) * L, 0.0]) + L * e
+        b.add_body(f"coupler{i}", m, J, Bl + np.array([0.5 * L, 0.0]), orientation=0.0, velocity=vB)
+    for i in range(n_windows + 1):
+        b.add_revolute(f"O{i}", "ground", f"bar{i}", (i * L, 0.0))
+    for i in range(n_windows + 1):
+        Bi = np.array([i * L, 0.0]) + L * e
+        if i > 0:
+            b.add_revolute(f"B{i}/L", f"coupler{i}", f"bar{i}", Bi)
+        if i < n_windows:
+            b.add_revolute(f"B{i}/R", f"bar{i}", f"coupler{i + 1}", Bi)
+    return b.build(redundant=redundant)
+
+
+def iftomm_a02_reference(t_eval, n_windows: int = 40, link_length: float = 1.0, speed: float = 1.0,
+                         angle0: float = np.pi / 2, gravity: float = G_EARTH, rtol: float = 1e-12,
+                         atol: float = 1e-12):
+    r"""Minimal-coordinate reference of :func:`iftomm_a02_four_bar_chain`: bar angle φ(t).
+
+    Equal masses m cancel: ``[(N+1)/3 + N] L φ̈ = −g cos φ [(N+1)/2 + N]`` (see the model
+    docstring), integrated with DOP853.  ``x(B_0) = L cos φ``, ``y(B_0) = L sin φ``.
+
+    Returns
+    -------
+    phi, phidot : ndarray, shape (n_t,)
+        [rad], [rad/s] at ``t_eval`` [s].
+    """
+    t_eval = np.asarray(t_eval, float)
+    N, L = int(n_windows), float(link_length)
+    c = gravity * ((N + 1) / 2 + N) / (L * ((N + 1) / 3 + N))
+    w0 = _a02_rate(float(angle0), float(speed), L)
+    sol = solve_ivp(lambda t, y: [y[1], -c * np.cos(y[0])], (0.0, float(t_eval[-1])), [float(angle0), w0],
+                    method="DOP853", rtol=rtol, atol=atol, t_eval=t_eval)
+    if sol.status != 0:
+        raise RuntimeError(f"iftomm_a02_reference: DOP853 failed: {sol.message}")
+    return sol.y[0], sol.y[1]
+
+
+# --------------------------------------------------------------------------------------------
+# IFToMM A04: Bricard mechanism
+# --------------------------------------------------------------------------------------------
+
+#: Joint points and global axes of the Bricard mechanism at t = 0 (A04), L = 1 m.
+BRICARD_JOINTS = (
+    ("J1", "ground", "rod1", (0.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
+    ("J2", "rod1", "rod2", (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    ("J3", "rod2", "rod3", (1.0, -1.0, 0.0), (1.0, 0.0, 0.0)),
+    ("J4", "rod3", "rod4", (1.0, -1.0, 1.0), (0.0, 1.0, 0.0)),
+    ("J5", "rod4", "rod5", (0.0, -1.0, 1.0), (0.0, 0.0, 1.0)),
+    ("J6", "rod5", "ground", (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)),
+)
+
+
+def iftomm_a04_bricard(link_length: float = 1.0, link_mass: float = 1.0, cross_section: float = 0.1,
+                       gravity: float = G_EARTH, redundant: str = "keep") -> Model:
+    r"""IFToMM benchmark A04: Bricard's over-constrained 6R mechanism (5 rods + ground).
+
+    Geometry at t = 0 (L = 1 m; the IFToMM description as implemented in the open OpenSim port
+    of the library, RehabEngGroup/MBSbenchmarksInOpenSim ``src/A04-BricardsMechanism``, whose
+    fifth rod is split into two welded halves): the closed chain of six unit edges
+    O → P1 → P2 → P3 → P4 → P5 → O with
+
+    ====== ================ ================ =====================
+    rod    from             to               joint at "from", axis
+    ====== ================ ================ =====================
+    rod1   O  = (0, 0, 0)   P1 = (1, 0, 0)   J1, y (to ground)
+    rod2   P1               P2 = (1, −1, 0)  J2, z
+    rod3   P2               P3 = (1, −1, 1)  J3, x
+    rod4   P3               P4 = (0, −1, 1)  J4, y
+    rod5   P4               P5 = (0, 0, 1)   J5, z
+    ====== ================ ================ =====================
+
+    and J6 at P5 = (0, 0, 1), axis x, joining rod5 to the ground (the ground "link" is the
+    edge P5–O).  Every joint axis is perpendicular to both links it joins and to the
+    neighbouring axes: the trihedral Bricard linkage.  Gravity 9.81 m/s² along −y; the
+    mechanism starts at rest (no initial speed is set in the OpenSim port) and moves under
+    gravity for 10 s; energy is conserved.
+
+    Rods: uniform, mass 1 kg, square cross-section of side ``cross_section`` = 0.1 m (as the
+    OpenSim port; ``J_axial = m a²/6``, ``J_transverse = m (L² + a²)/12``), centre of mass at
+    mid-length.
+
+    Redundancy: 5 spatial bodies (30 velocity coordinates) and 6 revolute joints (30 equations)
+    give a Grübler count of 0, yet the linkage moves with one degree of freedom: ``Φ_q`` has
+    rank 29 and one equation is dependent at every configuration of the motion.  ``build``
+    detects it by pivoted QR (the dependent row is named in ``model.redundant_constraints``);
+    ``redundant='keep'`` keeps all 30 rows (minimum-norm multipliers), ``'remove'`` deletes
+    the named row (unique multipliers of the remaining 29).
+
+    Parameters
+    ----------
+    link_length, link_mass, cross_section : float
+        L [m], m [kg], a [m].
+    gravity : float
+        [m/s²] along −y.
+    redundant : {'raise', 'remove', 'keep'}
+
+    Returns
+    -------
+    Model
+        Bodies ``rod1..rod5``; joints ``J1..J6``.
+
+    References
+    ----------
+    R. Bricard, "Mémoire sur la théorie de l'octaèdre articulé", J. Math. Pures Appl. 3 (1897)
+    113–148.  M. González, D. Dopico, U. Lugrís, J. Cuadrado, Multibody Syst. Dyn. 16 (2006)
+    179–190; IFToMM Library of Computational Benchmark Problems, problem A04.
+    """
+    L = _check_positive("iftomm_a04_bricard: link_length", link_length)
+    m = _check_positive("iftomm_a04_bricard: link_mass", link_mass)
+    a = _check_positive("iftomm_a04_bricard: cross_section", cross_section)
+    Jax, Jtr = m * a * a / 6.0, m * (L * L + a * a) / 12.0
+    pts = [L * np.asarray(j[3]) for j in BRICARD_JOINTS] + [np.zeros(3)]
+    b = ModelBuilder(3, "iftomm_a04_bricard", gravity=(0.0, -gravity, 0.0))
+    for k in range(5):
+        P, Q = pts[k], pts[k + 1]
+        d = (Q - P) / L
+        # body x axis along the rod: rotation taking e_x to d
+        ex = np.array([1.0, 0.0, 0.0])
+        ax = np.cross(ex, d)
+        s, c = np.linalg.norm(ax), float(ex @ d)
+        if s < 1e-12:
+            ori = np.array([1.0, 0.0, 0.0, 0.0]) if c > 0 else frames.axis_angle_to_euler([0.0, 0.0, 1.0], np.pi)
+        else:
+            ori = frames.axis_angle_to_euler(ax / s, np.arctan2(s, c))
+        b.add_body(f"rod{k + 1}", m, np.array([Jax, Jtr, Jtr]), 0.5 * (P + Q), orientation=ori)
+    for name, bi, bj, at, axis in BRICARD_JOINTS:
+        b.add_revolute(name, bi, bj, L * np.asarray(at), axis=axis)
+    return b.build(redundant=redundant)
+
+
+__all__ += ["andrews_cartesian", "andrews_angles_from_cartesian", "iftomm_a02_four_bar_chain",
+            "iftomm_a02_reference", "iftomm_a04_bricard", "BRICARD_JOINTS"]

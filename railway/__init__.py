@@ -11,7 +11,12 @@ creep modules):
 * :mod:`railway.contact_search` -- vectorised four-condition contact search (Pombo, Ambrosio &
   Silva 2007) with tread and flange candidates, global re-seeding and warm starts;
 * :mod:`railway.contact_geometry` -- rigid contact-geometry table and equivalent conicity
-  (EN 15302).
+  (EN 15302), flange lead with yaw;
+* :mod:`railway.forces` -- Hertz + Lankarani-Nikravesh normal and creep forces of all contacts
+  of a search in one (compiled) call;
+* :mod:`railway.two_point` -- two-point contact: conical profile, rigid onset, brute-force check;
+* :mod:`railway.quasi_static` -- wheelset position under vertical wheel loads (elastic Hertz);
+* :mod:`railway.scenes` -- scenes for ``mbsuite run``.
 
 SI units throughout (m, rad); mm only in profile files and CLI output.
 """
@@ -24,7 +29,9 @@ from .contact_geometry import (
     rigid_contact,
 )
 from .contact_search import ContactResult, ContactSearch, wheelset_pose
+from .forces import ContactForces
 from .profiles import RailProfile, WheelProfile, read_profile_file, s1002_exact, uic60_exact
+from .quasi_static import quasi_static_contact
 from .surfaces import RailSurface, WheelSurface
 from .track import (
     Curve,
@@ -38,6 +45,7 @@ from .track import (
 )
 
 __all__ = [
+    "ContactForces",
     "ContactResult",
     "ContactSearch",
     "Curve",
@@ -56,6 +64,7 @@ __all__ = [
     "equivalent_conicity",
     "flange_contact_onset",
     "parse_inclination",
+    "quasi_static_contact",
     "read_profile_file",
     "rigid_contact",
     "s1002_exact",

@@ -20,7 +20,7 @@ except ImportError:  # pragma: no cover - exercised only without numba
     numba = None
     HAVE_NUMBA = False
 
-__all__ = ["HAVE_NUMBA", "newton_kernel"]
+__all__ = ["HAVE_NUMBA", "newton_kernel", "scan_kernel"]
 
 
 def _define():
@@ -290,7 +290,87 @@ def _define():
     return newton
 
 
+def _define_scan():
+    njit = numba.njit(cache=True, fastmath=False)
+
+    @njit
+    def scan(r, ax, d, pos, tan, lat, up, sig, L, yg, rg, F1g, side_left, b0, u0, Y0, Z0,
+             b1, u1, Y1, Z1, ulo, uhi, theta, s0, n_rank, out):
+        """Seeds of the global cross-section scan (see ContactSearch._seed_scan), per problem."""
+        P, G = yg.shape
+        Yo = np.empty(G); Zw = np.empty(G); xi = np.empty(G); beta = np.empty(G)
+        gap = np.empty(G); h4 = np.empty(G); ok = np.empty(G, dtype=np.bool_)
+        gmid = np.empty(G - 1); tt = np.empty(G - 1)
+        for p in range(P):
+            for g in range(G):
+                w = sig[p] * (yg[p, g] + L)
+                rel0 = r[p, 0] + w * ax[p, 0] - rg[p, g] * d[p, 0] - pos[p, 0]
+                rel1 = r[p, 1] + w * ax[p, 1] - rg[p, g] * d[p, 1] - pos[p, 1]
+                rel2 = r[p, 2] + w * ax[p, 2] - rg[p, g] * d[p, 2] - pos[p, 2]
+                Yo[g] = (rel0 * lat[p, 0] + rel1 * lat[p, 1] + rel2 * lat[p, 2]) * sig[p]
+                Zw[g] = rel0 * up[p, 0] + rel1 * up[p, 1] + rel2 * up[p, 2]
+                xi[g] = rel0 * tan[p, 0] + rel1 * tan[p, 1] + rel2 * tan[p, 2]
+                t0 = -F1g[p, g] * d[p, 0] + sig[p] * ax[p, 0]
+                t1 = -F1g[p, g] * d[p, 1] + sig[p] * ax[p, 1]
+                t2 = -F1g[p, g] * d[p, 2] + sig[p] * ax[p, 2]
+                beta[g] = np.arctan2(t0 * up[p, 0] + t1 * up[p, 1] + t2 * up[p, 2],
+                                     (t0 * lat[p, 0] + t1 * lat[p, 1] + t2 * lat[p, 2]) * sig[p])
+            if side_left[p]:
+                ug = np.interp(beta, b0, u0); Yr = np.interp(beta, b0, Y0); Zr = np.interp(beta, b0, Z0)
+            else:
+                ug = np.interp(beta, b1, u1); Yr = np.interp(beta, b1, Y1); Zr = np.interp(beta, b1, Z1)
+            j0 = 0
+            gbest = 1e300
+            for g in range(G):
+                cb, sb = np.cos(beta[g]), np.sin(beta[g])
+                dY, dZ = Yo[g] - Yr[g], Zw[g] - Zr[g]
+                ok[g] = (ug[g] > ulo[p]) and (ug[g] < uhi[p])
+                gap[g] = -dY * sb + dZ * cb if ok[g] else np.inf
+                h4[g] = dY * cb + dZ * sb
+                gv = gap[g] if np.isfinite(gap[g]) else 1e300
+                if gv < gbest:
+                    gbest = gv
+                    j0 = g
+            for g in range(G - 1):
+                ch = (h4[g] * h4[g + 1] <= 0.0) and ok[g] and ok[g + 1]
+                den = h4[g] - h4[g + 1] if ch else 1.0
+                t = min(max(h4[g] / den, 0.0), 1.0)
+                tt[g] = t
+                gmid[g] = gap[g] + t * (gap[g + 1] - gap[g]) if ch else np.inf
+            jprev = -1
+            for rank in range(n_rank):
+                if rank > 0:
+                    gmid[jprev] = np.inf
+                j = 0
+                for g in range(1, G - 1):
+                    if gmid[g] < gmid[j]:
+                        j = g
+                jprev = j
+                if np.isfinite(gmid[j]):
+                    jj, tj = j, tt[j]
+                else:
+                    jj = min(j0, G - 2)
+                    tj = 1.0 if j0 == G - 1 else 0.0
+                out[rank, p, 0] = theta[p]
+                out[rank, p, 1] = yg[p, jj] + tj * (yg[p, jj + 1] - yg[p, jj])
+                out[rank, p, 2] = s0[p] + xi[jj] + tj * (xi[jj + 1] - xi[jj])
+                out[rank, p, 3] = ug[jj] + tj * (ug[jj + 1] - ug[jj])
+
+    return scan
+
+
 _NEWTON = None
+_SCAN = None
+
+
+def scan_kernel():
+    """The compiled seed scan (compiled on first use), or None without numba."""
+    global _SCAN
+    if not HAVE_NUMBA:
+        return None
+    if _SCAN is None:
+        _SCAN = _define_scan()
+    return _SCAN
 
 
 def newton_kernel():

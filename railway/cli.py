@@ -58,6 +58,10 @@ def _add_contact_table(sub):
     p.add_argument("--yaw-mrad", type=float, default=0.0, help="wheelset yaw angle")
     p.add_argument("--amplitudes-mm", default="2,3,4",
                    help="comma-separated amplitudes for the equivalent conicity")
+    p.add_argument("--load-kN", type=float, default=None,
+                   help="also solve the quasi-static elastic contact under this vertical load per "
+                        "wheel (Hertz normal forces balance the load) and report normal and "
+                        "lateral forces per contact")
     p.add_argument("-o", "--out", default=None, help="output folder (default: print only)")
     p.set_defaults(func=run_contact_table)
     return p
@@ -91,6 +95,9 @@ def run_contact_table(args) -> int:
         amps = np.array([float(a) for a in args.amplitudes_mm.split(",")]) * 1e-3
     except ValueError:
         raise ValueError(f"--amplitudes-mm {args.amplitudes_mm!r}: expected e.g. 2,3,4") from None
+    load = getattr(args, "load_kN", None)
+    if load is not None and not (np.isfinite(load) and load > 0):
+        raise ValueError(f"--load-kN {load!r}: the vertical wheel load must be positive")
     wheel = _load_wheel(args.wheel, args.r0_mm * 1e-3)
     rail = _load_rail(args.rail)
     y = np.linspace(-args.y_max_mm, args.y_max_mm, args.n) * 1e-3
@@ -105,16 +112,36 @@ def run_contact_table(args) -> int:
         f"flange contact from lateral shift {y_f * 1e3:.2f} mm, contact angle "
         f"{np.degrees(g_f):.1f} deg",
     ]
+    if "lead_L [m]" in df.columns and np.isfinite(y_f):
+        row = df.loc[(df["y [m]"] - y_f).abs().idxmin()]
+        summary.append(f"yaw {args.yaw_mrad:g} mrad: contact lead (ahead of the wheel centre) at "
+                       f"flange onset {row['lead_L [m]'] * 1e3:.2f} mm (left wheel)")
     for _, row in con.iterrows():
         summary.append(
             f"equivalent conicity at {row['amplitude [m]'] * 1e3:g} mm: "
             f"{row['conicity wavelength [-]']:.4f} (wavelength), "
             f"{row['conicity harmonic [-]']:.4f} (harmonic), dr/2y {row['delta_r/2y [-]']:.4f}")
+    qs = None
+    if load is not None:
+        from .quasi_static import quasi_static_contact
+
+        qs = quasi_static_contact(y, load * 1e3, yaw=args.yaw_mrad * 1e-3, wheel=wheel, rail=rail,
+                                  gauge=args.gauge_mm * 1e-3, inclination=args.inclination,
+                                  flange_back_spacing=args.flange_back_mm * 1e-3)
+        two = qs.groupby(["y [m]", "side"]).size()
+        two = two[two > 1]
+        summary.append(f"quasi-static contact under {load:g} kN per wheel: max normal force "
+                       f"{qs['N [N]'].max() / 1e3:.1f} kN, max |lateral force| "
+                       f"{qs['Fy [N]'].abs().max() / 1e3:.1f} kN"
+                       + (f", two-point contact at {len(two)} (shift, side) pairs from "
+                          f"{two.index[0][0] * 1e3:.2f} mm" if len(two) else ", no two-point contact"))
     print("\n".join(summary))
     if args.out:
         out = Path(args.out)
         _write_table(df, out, "contact_table")
         _write_table(con, out, "equivalent_conicity")
+        if qs is not None:
+            _write_table(qs, out, "quasi_static")
         (out / "summary.md").write_text("\n".join(f"- {s}" for s in summary) + "\n", encoding="utf-8")
         fig = plot_contact_table(df)
         fig.savefig(out / "contact_table.png", dpi=120)

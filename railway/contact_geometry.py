@@ -88,7 +88,10 @@ def rigid_contact(lateral, yaw=0.0, wheel=None, rail=None, gauge=1.435, inclinat
     roll : (N,) ndarray
         Roll angle (rad, positive lifts the left wheel).
     res : ContactResult
-        Contacts at the solution (wheels ordered shift by shift, left then right).
+        Contacts at the solution (wheels ordered shift by shift, left then right);
+        ``res.extra["lead"]`` (2N, 2) holds the longitudinal position (m) of each candidate's
+        wheel contact point ahead of its wheel centre along the track tangent (the flange
+        lead of a yawed wheelset).
     active : (N, 2) ndarray of int
         Candidate (0 tread, 1 flange) with the smaller gap on each wheel.
     """
@@ -154,6 +157,13 @@ def rigid_contact(lateral, yaw=0.0, wheel=None, rail=None, gauge=1.435, inclinat
                                f"(axle height {float(z[k])!r} m, roll {float(roll[k])!r} rad)")
         raise RuntimeError(f"rigid contact: no convergence in {max_iter} iterations "
                            f"(largest gap {np.max(np.abs(gs))!r} m)")
+    # lead: longitudinal position of each contact point ahead of its wheel centre (the centre
+    # of the taping-line circle), measured along the track tangent; non-zero with a yaw angle
+    sig = np.array([1.0, -1.0])
+    centre = r[:, None, :] + (sig[None, :, None] * cs.L) * A[:, None, :, 1]  # (N, 2, 3)
+    tangent = track.evaluate(s).R[:, :, 0]
+    rel = res.point_wheel.reshape(N, 2, 2, 3) - centre[:, :, None, :]
+    res.extra["lead"] = np.einsum("nsck,nk->nsc", rel, tangent).reshape(2 * N, 2)
     return z, roll, res, active
 
 
@@ -179,7 +189,9 @@ def contact_geometry_table(lateral=None, yaw=0.0, wheel=None, rail=None, gauge=1
         taping line), ``u_rail`` (rail profile coordinate from the rail axis, field side
         positive), ``Y_contact`` (lateral position of the rail contact point in the track frame),
         ``r`` (rolling radius), ``gamma`` (contact angle), ``flange`` (flag), ``two_point``
-        (tread and flange both touching within 1 um).
+        (tread and flange both touching within 1 um) and, when a yaw angle is given,
+        ``lead`` (longitudinal position of the contact point ahead of the wheel centre along
+        the track, m).
     """
     if lateral is None:
         lateral = np.linspace(-0.010, 0.010, 401)
@@ -209,6 +221,8 @@ def contact_geometry_table(lateral=None, yaw=0.0, wheel=None, rail=None, gauge=1
         cols[f"gamma_{lab} [rad]"] = gam[:, k]
         cols[f"flange_{lab}"] = flange[:, k]
         cols[f"two_point_{lab}"] = two[:, k]
+        if np.any(np.asarray(yaw) != 0.0):
+            cols[f"lead_{lab} [m]"] = pick(res.extra["lead"])[:, k]
     df = pd.DataFrame(cols)
     df.attrs.update(wheel=wheel.name, r0=wheel.r0, gauge=gauge, inclination=inclination,
                     flange_back_spacing=flange_back_spacing)

@@ -33,7 +33,8 @@ Solution strategy
   lost.
 * A Newton step below ``tol_linear`` is applied without a further pass; the outputs are then
   linearised about the evaluated point (error O(step^2)).
-* With numba installed the same iteration runs in a compiled kernel (:mod:`railway._kernels`).
+* With numba installed the same iteration, and the seed scan, run in compiled kernels
+  (:mod:`railway._kernels`); the numpy code is the reference (tests compare both).
 
 References
 ----------
@@ -283,10 +284,12 @@ class ContactSearch:
         if compiled not in ("auto", True, False):
             raise ValueError(f"compiled must be 'auto', True or False, got {compiled!r}")
         self._kernel = None
+        self._scan_kernel = None
         if compiled:
-            from ._kernels import newton_kernel
+            from ._kernels import newton_kernel, scan_kernel
 
             self._kernel = newton_kernel()
+            self._scan_kernel = scan_kernel()
             if self._kernel is None and compiled is True:
                 raise ImportError("compiled=True needs numba (pip install numba)")
         w = self.wheel
@@ -336,12 +339,23 @@ class ContactSearch:
         lo = np.stack([np.full(P, -np.inf), pc["ylo"], np.full(P, -np.inf), pc["ulo"]], axis=1)
         hi = np.stack([np.full(P, np.inf), pc["yhi"], np.full(P, np.inf), pc["uhi"]], axis=1)
         pc["lo"], pc["hi"] = lo, hi
+        pc["lo_e"], pc["hi_e"] = lo + 1e-12, hi - 1e-12  # strict-inside bounds
+        pc["is_flange"] = pc["cand"] == FLANGE
         return pc
 
-    @staticmethod
-    def _rep(pc, k):
-        return {key: (np.concatenate([v] * k) if isinstance(v, np.ndarray) else v)
-                for key, v in pc.items()}
+    def _rep(self, pc, k):
+        """pc with every array repeated k times (cached: the problem sets are fixed)."""
+        cache = self.__dict__.setdefault("_rep_cache", {})
+        key = (id(pc), k)
+        hit = cache.get(key)
+        if hit is not None and hit[0] is pc:
+            return hit[1]
+        out = {key_: (np.concatenate([v] * k) if isinstance(v, np.ndarray) else v)
+               for key_, v in pc.items()}
+        if len(cache) > 16:
+            cache.clear()
+        cache[key] = (pc, out)
+        return out
 
     def _residual_jac(self, x, pc, r_ws, AT):
         """Residuals h (M, 4) of the four contact conditions and their analytic Jacobian.
@@ -598,13 +612,25 @@ class ContactSearch:
         """
         P = pc["sig"].size
         ws = pc["ws"]
-        fr_pos, _, fr_R, _ = self.track._frame(s_ws[ws])
+        # frames and directions per wheelset, then per problem
+        fr_pos, _, fr_R, _ = self.track._frame(s_ws)
+        up_w = fr_R[:, :, 2]
+        ax_w = A[:, :, 1]  # axle direction
+        d_w = up_w - np.sum(up_w * ax_w, axis=1)[:, None] * ax_w
+        d_w /= np.linalg.norm(d_w, axis=1)[:, None]  # lowest point direction is -d
+        fr_pos, fr_R, ax, d = fr_pos[ws], fr_R[ws], ax_w[ws], d_w[ws]
         tan, lat, up = fr_R[:, :, 0], fr_R[:, :, 1], fr_R[:, :, 2]
-        ax = A[ws, :, 1]  # axle direction
-        d = up - np.sum(up * ax, axis=1)[:, None] * ax
-        d /= np.linalg.norm(d, axis=1)[:, None]  # lowest point direction is -d
         sig = pc["sig"]
         yg, rg, F1g = (self._scan[k][pc["cand"]] for k in ("y", "r", "F1"))  # (P, G)
+        if self._scan_kernel is not None:  # the same scan, compiled (railway._kernels)
+            dl = np.einsum("pkj,pk->pj", A[ws], -d)
+            theta = np.arctan2(dl[:, 0], -dl[:, 2])
+            (b0, u0, Y0, Z0), (b1, u1, Y1, Z1) = self._rail_tab
+            out = np.empty((2 if second else 1, P, 4))
+            self._scan_kernel(np.ascontiguousarray(r_ws[ws]), ax, d, fr_pos, tan, lat, up, sig,
+                              self.L, yg, rg, F1g, sig > 0, b0, u0, Y0, Z0, b1, u1, Y1, Z1,
+                              pc["ulo"], pc["uhi"], theta, s_ws[ws], out.shape[0], out)
+            return list(out) if second else out[0]
         ctr = r_ws[ws][:, None, :] + (sig[:, None] * (yg + self.L))[:, :, None] * ax[:, None, :]
         pts = ctr - rg[:, :, None] * d[:, None, :]
         rel = pts - fr_pos[:, None, :]
@@ -671,7 +697,7 @@ class ContactSearch:
         """Validity, outputs and per-wheel (tread, flange) arrays."""
         P = x.shape[0]
         gap, S, V = self._outputs(x, pc, info)
-        inside = np.all((x > pc["lo"] + 1e-12) & (x < pc["hi"] - 1e-12), axis=1)
+        inside = np.all((x > pc["lo_e"]) & (x < pc["hi_e"]), axis=1)
         valid = conv & inside & (gap > -self.max_penetration) & np.isfinite(gap)
         # duplicates in the zone overlap: keep the candidate whose own zone holds the point
         v2, x2 = valid.reshape(-1, 2), x.reshape(-1, 2, 4)
@@ -691,10 +717,15 @@ class ContactSearch:
             theta=S[..., 0], y_wheel=S[..., 1], s_rail=S[..., 2], u_rail=S[..., 3],
             rolling_radius=S[..., 4], contact_angle=S[..., 5], wheel_angle=S[..., 6],
             k_wheel_rolling=S[..., 7], k_wheel_lateral=S[..., 8], k_rail_rolling=S[..., 9],
-            k_rail_lateral=S[..., 10], flange=(pc["cand"] == FLANGE).reshape(P // 2, 2),
+            k_rail_lateral=S[..., 10], flange=pc["is_flange"].reshape(P // 2, 2),
             residual=np.max(np.abs(H0), axis=1).reshape(P // 2, 2), iterations=iterations)
 
     def _check_pose(self, r_ws, A, s_ws, n_ws):
+        if (type(r_ws) is np.ndarray and type(A) is np.ndarray and type(s_ws) is np.ndarray
+                and r_ws.dtype == np.float64 and A.dtype == np.float64 and s_ws.dtype == np.float64
+                and r_ws.shape == (n_ws, 3) and A.shape == (n_ws, 3, 3) and s_ws.shape == (n_ws,)
+                and np.isfinite(r_ws.sum() + A.sum() + s_ws.sum())):
+            return r_ws, A, s_ws  # fast path on trajectories (a NaN or inf makes the sum non-finite)
         r_ws = np.asarray(r_ws, dtype=float).reshape(n_ws, 3)
         A = np.asarray(A, dtype=float).reshape(n_ws, 3, 3)
         s_ws = np.asarray(s_ws, dtype=float).reshape(n_ws)
@@ -802,7 +833,7 @@ class ContactSearch:
 
     def _valid_gap(self, x, conv, info, pc):
         """Validity (converged inside the zones, plausible gap) and gap (inf when invalid)."""
-        inside = np.all((x > pc["lo"] + 1e-12) & (x < pc["hi"] - 1e-12), axis=1)
+        inside = np.all((x > pc["lo_e"]) & (x < pc["hi_e"]), axis=1)
         g = info["gap"] if "gap" in info else np.einsum("ij,ij->i", info["d"], info["n"])
         ok = conv & inside & (g > -self.max_penetration)
         return ok, np.where(ok, g, np.inf)

@@ -83,26 +83,20 @@ __all__ = [
     "kalker_table_path",
 ]
 
-REPO_ROOT = Path(__file__).resolve().parents[1]
-_KALKER_FILE = Path("railway") / "kalker_coefficients.csv"
-#: Last-resort location while the project data folder is being populated (shared workspace copy).
-_FALLBACK_DATA_DIRS = (Path("/work/shared/data"),)
+_KALKER_FILE = ("railway", "kalker_coefficients.csv")
 
 
 def kalker_table_path() -> Path:
-    """Path of ``kalker_coefficients.csv``: ``<repo>/data/railway/`` first, then fallbacks.
+    """Path of ``kalker_coefficients.csv`` in the checkout's ``data/railway/`` folder.
 
     Raises
     ------
     FileNotFoundError
-        Naming every location searched.
+        If the file is missing from the project's data folder (its path is named).
     """
-    candidates = [REPO_ROOT / "data" / _KALKER_FILE] + [d / _KALKER_FILE for d in _FALLBACK_DATA_DIRS]
-    for p in candidates:
-        if p.is_file():
-            return p
-    raise FileNotFoundError("kalker_coefficients.csv not found; looked in "
-                            + ", ".join(str(p) for p in candidates))
+    from core.paths import data_path
+
+    return data_path(*_KALKER_FILE)
 
 
 @functools.lru_cache(maxsize=1)

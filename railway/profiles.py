@@ -48,6 +48,8 @@ from pathlib import Path
 
 import numpy as np
 
+from core.paths import data_path
+
 from ._ppoly import PiecewisePoly
 
 __all__ = [
@@ -60,7 +62,7 @@ __all__ = [
     "read_profile_file",
 ]
 
-DATA_DIR = Path(__file__).resolve().parent.parent / "data" / "railway"
+DATA_DIR = data_path("railway", must_exist=False)
 _MM = 1e-3
 
 

@@ -406,6 +406,7 @@ def parse_inclination(value):
 
     A negative value (rail tilted away from the track centre) is rejected.
     """
+    given = value
     if isinstance(value, str):
         v = value.strip().lower()
         if v in ("vertical", "0", "none"):
@@ -426,7 +427,9 @@ def parse_inclination(value):
         raise ValueError(f"rail inclination {value!r} is not finite")
     if value < 0.0:
         raise ValueError(
-            f"rail inclination {value!r} is negative: rails are inclined towards the track "
+            f"rail inclination {value!r}"
+            + (f" (given as {given!r})" if isinstance(given, str) else "")
+            + " is negative: rails are inclined towards the track "
             f"centre, give tan(alpha) >= 0 (e.g. 1/40 = 0.025)")
     if value > 0.2:
         raise ValueError(f"rail inclination {value!r} is implausibly large (tan alpha > 0.2)")

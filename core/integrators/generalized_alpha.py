@@ -252,7 +252,7 @@ class GeneralizedAlpha(Integrator):
     @classmethod
     def accepted_options(cls):
         return ("rho_inf", "adaptive", "h_min", "velocity_projection", "max_newton", "theta_refresh",
-                "consistent_start", "geometric_stiffness")
+                "consistent_start", "geometric_stiffness", "newton_tol")
 
     def __init__(self, system, t_span, q0=None, v0=None, **kw):
         super().__init__(system, t_span, q0, v0, **kw)
@@ -260,6 +260,14 @@ class GeneralizedAlpha(Integrator):
         self.rho_inf = float(o.get("rho_inf", 0.9))
         self.alpha_m, self.alpha_f, self.beta, self.gamma = alpha_parameters(self.rho_inf, self.variant)
         self.adaptive = bool(o.get("adaptive", False))
+        # Newton tolerance (relative; absolute = 1e-2 × relative × unit scale). With a fixed step the
+        # discretisation error is set by h, so the nonlinear solve must be well below it: tying it to
+        # the default rtol = 1e-6 made the scheme look first-order; 1e-8 restores order 2 (1e-9 and
+        # below can stall on round-off of the scaled increments at h = 1e-4).
+        # Adaptive runs use rtol/atol as given.
+        default_ntol = self.rtol if self.adaptive else min(self.rtol, 1e-8)
+        self.newton_rtol = float(o.get("newton_tol", default_ntol))
+        self.newton_atol = self.atol if self.adaptive and "newton_tol" not in o else min(self.atol, 1e-2 * self.newton_rtol)
         self.h_min = float(o.get("h_min", 1e-6 * self.h))
         self.velocity_projection = bool(o.get("velocity_projection", False))
         self.max_newton = int(o.get("max_newton", 12))
@@ -342,8 +350,20 @@ class GeneralizedAlpha(Integrator):
         a1 = ca * vd + c0
         x = base_x + bh2 * a1
         v1 = base_v + h * gam * a1
-        wq = 1.0 / (self.atol + self.rtol * q_magnitude(sys_, self.q))
-        wv = 1.0 / (self.atol + self.rtol * np.abs(self.v))
+        # weights floored at the rounding level of each block: the constraint rows mix fast and
+        # slow members (Andrews: crank at 400 rad/s, others at 1e-3 rad/s), so every increment
+        # carries a noise of ~ε‖block‖∞ amplified by the conditioning; asking for less never
+        # converges (contraction ≈ 1 at any h). Same remedy as radau-ggl's _newton_scale.
+        qmag = q_magnitude(sys_, self.q)
+        noise = 1e3 * np.finfo(float).eps
+        sq = np.maximum(self.newton_atol + self.newton_rtol * qmag, noise * np.max(qmag, initial=0.0))
+        # velocities follow from position increments through v = … + γ/(βh) x, so their noise also
+        # includes the position round-off amplified by γ/(βh): the O(ε/h) velocity round-off of
+        # index-3 schemes at small steps
+        gp_ = self.gamma / (self.beta * h)
+        sv = np.maximum(self.newton_atol + self.newton_rtol * np.abs(self.v),
+                        noise * max(np.max(np.abs(self.v), initial=0.0), 0.1 * gp_ * np.max(qmag, initial=0.0)))
+        wq, wv = 1.0 / sq, 1.0 / sv
         gp = gam / (beta * h)  # δv = γ' δx
         bp = 1.0 / (ca * bh2)  # δv̇ = β' δx
         if self._lu_h != h:
@@ -381,12 +401,17 @@ class GeneralizedAlpha(Integrator):
             dnorm = np.sqrt(max(eq @ eq, gp * gp * (ev @ ev)) / nv) if nv else 0.0
             # the multipliers must converge too: with a reused iteration matrix the position
             # increments can be tiny while λ is still far off (e.g. massless rotations, where λ
-            # alone balances the equations); measure δλ against the force level of the step
-            if len(dlam):
-                f_scale = max(float(np.max(np.abs(lam))), float(np.max(np.abs(Qv))) if nv else 0.0, 1e-300)
-                # relative floor 1e-8: λ comes out of the scaled KKT solve as d/(βh²), whose
-                # round-off (~eps·cond) would otherwise stall Newton at very tight rtol
-                dnorm = max(dnorm, float(np.max(np.abs(dlam))) / (max(self.rtol, 1e-8) * f_scale + self.atol))
+            # alone balances the equations). The force-equilibrium residual r1 of this iterate
+            # measures that; its round-off is ~eps·(force level) whatever h is, whereas δλ = d/(βh²)
+            # amplifies round-off at small h.
+            f_scale = max(float(np.max(np.abs(Qv))) if nv else 0.0, float(np.max(np.abs(Mc @ vd))) if nv else 0.0,
+                          float(np.max(np.abs(r1 - Mc @ vd + Qv))) if nv else 0.0, 1e-300)
+            # floor: Φ = 0 holds only to round-off ε|q|, which the 1/(βh²) scaling turns into a force
+            # noise ~ ε |M| |q| / (βh²) -- the known O(ε/h²) multiplier round-off of index-3 schemes
+            m_scale = float(np.max(np.abs(Mc.diagonal()))) if nv else 0.0
+            q_scale = max(1.0, float(np.max(np.abs(self.q)))) if len(self.q) else 1.0
+            floor = 100.0 * np.finfo(float).eps * m_scale * q_scale / bh2
+            force_ok = float(np.max(np.abs(r1))) <= max(max(self.newton_rtol, 1e-12) * f_scale, floor) if nv else True
             if not np.isfinite(dnorm):
                 return False, f"Newton iteration diverged (non-finite increment) at t = {t1:.6g} s"
             if norm_old is None:
@@ -398,7 +423,7 @@ class GeneralizedAlpha(Integrator):
                 if theta < 1.0:
                     self._eta = theta / (1.0 - theta)
                     conv = self._eta * dnorm <= 1.0
-            if conv or dnorm == 0.0:
+            if (conv and force_ok) or dnorm == 0.0:
                 q1 = sys_.retract(self.q, x)
                 self._trial = (t1, q1, v1, vd, a1, lam)
                 # keep the matrix for the next step while convergence is fast

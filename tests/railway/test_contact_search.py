@@ -269,3 +269,18 @@ def test_implementations_agree_along_a_trajectory(other):
         np.testing.assert_allclose(a.gap[m], b.gap[m], atol=tol)
         np.testing.assert_allclose(a.point_rail[m], b.point_rail[m], atol=1e3 * tol)
         np.testing.assert_allclose(a.normal[m], b.normal[m], atol=1e4 * tol)
+
+
+def test_compiled_seed_scan_equals_numpy():
+    pytest.importorskip("numba")
+    tr = _curved_track()
+    cs = ContactSearch(tr, n_wheelsets=2)
+    ref = ContactSearch(tr, n_wheelsets=2, compiled=False)
+    assert cs._scan_kernel is not None and ref._scan_kernel is None
+    for k in range(10):
+        s = np.array([30.0, 32.5]) + 0.7 * k
+        r, A = wheelset_pose(tr, s, 0.007 * np.sin(0.9 * k), R0 + 1e-4, 0.001 * np.cos(k), 0.004)
+        a = cs._seed_scan(cs._problems, r, A, s, second=True)
+        b = ref._seed_scan(ref._problems, r, A, s, second=True)
+        for x, y in zip(a, b):
+            np.testing.assert_allclose(x, y, rtol=0, atol=1e-12)

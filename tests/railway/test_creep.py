@@ -294,6 +294,8 @@ def test_registry_names_aliases_classes_and_user_models():
 @pytest.mark.parametrize("kwargs, match", [
     (dict(normal_force=-5.0), "normal_force must be >= 0, got -5.0 at index 0"),
     (dict(xi=np.nan), "xi must be finite, got nan at index 0"),
+    (dict(eta=[0.0, np.nan]), "eta must be finite, got nan at index 1"),
+    (dict(phi=np.nan), "phi must be finite, got nan at index 0"),
     (dict(phi=[0.0, np.inf]), "phi must be finite, got inf at index 1"),
     (dict(nu=0.7), "Poisson ratio nu must lie in \\[0, 0.5\\], got 0.7"),
     (dict(nu=-0.01), "Poisson ratio nu must lie in \\[0, 0.5\\], got -0.01"),
@@ -307,6 +309,12 @@ def test_bad_input_names_the_value(model, kwargs, match):
     args.update(kwargs)
     with pytest.raises(ValueError, match=match):
         get_creep_model(model)(**args)
+
+
+def test_kalker_table_comes_from_the_project_data_folder():
+    from core.paths import data_path
+
+    assert kalker_table_path() == data_path("railway", "kalker_coefficients.csv")
 
 
 def test_polach2005_parameter_checks():

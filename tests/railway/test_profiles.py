@@ -115,6 +115,9 @@ def test_wrong_inclination_sign_is_rejected():
         RailMounting(inclination=-1 / 40)
     with pytest.raises(ValueError, match="1:x"):
         parse_inclination("1:x")
+    # the CLI form with the wrong sign names the string as given
+    with pytest.raises(ValueError, match="given as '-1:40'"):
+        parse_inclination("-1:40")
 
 
 def test_measured_wheel_profile_from_file(tmp_path):

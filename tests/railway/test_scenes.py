@@ -1,0 +1,36 @@
+"""Railway scenes: registration through the entry point and fast smoke runs."""
+
+import pytest
+
+from core.scenes import Scene, run_scene
+from railway.scenes import railway_scenes
+
+NAMES = ["railway-contact-geometry", "railway-creep-curves", "railway-two-point-contact"]
+
+
+def test_scene_list():
+    scenes = railway_scenes()
+    assert [s.name for s in scenes] == NAMES
+    assert all(isinstance(s, Scene) for s in scenes)
+
+
+def test_creep_curves_scene_fast(tmp_path):
+    scene = {s.name: s for s in railway_scenes()}["railway-creep-curves"]
+    res = run_scene(scene, tmp_path, fast=True)
+    ex = res.tables["excerpt_Fx"]
+    # at small creepage every law starts on Kalker's slope: |Fx| <= the linear value
+    lin = ex["Fx kalker_linear [kN]"].abs()
+    for col in ex.columns:
+        if col.startswith("Fx "):
+            assert (ex[col].abs() <= lin * (1 + 1e-9)).all(), col
+    assert (tmp_path / "railway-creep-curves" / "Fx_vs_xi.png").exists()
+    assert "Kalker" in res.notes
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["railway-contact-geometry", "railway-two-point-contact"])
+def test_geometry_scenes_fast(tmp_path, name):
+    scene = {s.name: s for s in railway_scenes()}[name]
+    res = run_scene(scene, tmp_path, fast=True)
+    assert res.tables and res.figures
+    assert (tmp_path / name / "README.md").exists()

@@ -79,8 +79,19 @@ def solve_kkt(M, J, top: Array, bottom: Array, minimum_norm: bool = False) -> tu
         except (RuntimeError, FloatingPointError, ValueError):
             pass
     Kd = np.block([[_dense(M), _dense(J).T], [_dense(J), np.zeros((n_c, n_c))]])
-    sol, *_ = sla.lstsq(Kd, rhs, lapack_driver="gelsd")
+    if not (np.all(np.isfinite(Kd)) and np.all(np.isfinite(rhs))):
+        raise SingularKKTError("KKT system has non-finite entries (the state or the forces diverged)")
+    # relative rank cutoff: with the default (machine epsilon) an exact null direction of a
+    # redundant Φ_q with singular value ~1e-15·σmax is counted as rank, and λ then carries a
+    # component in null(Φ_qᵀ) -- it is no longer the minimum-norm multiplier
+    sol, *_ = sla.lstsq(Kd, rhs, cond=1e-12, lapack_driver="gelsd")
     res = Kd @ sol - rhs
+    if minimum_norm:
+        # redundant equations kept: γ is consistent only up to the drift of the state off the
+        # constraint manifold; the least-squares (minimum-norm) solution is the defined answer
+        if not np.all(np.isfinite(sol)):
+            raise SingularKKTError("minimum-norm KKT solution is not finite")
+        return sol[:n_v], sol[n_v:]
     if not np.all(np.isfinite(sol)) or np.linalg.norm(res) > 1e-6 * (1.0 + np.linalg.norm(rhs)):
         raise SingularKKTError(
             f"KKT system singular and inconsistent (residual {np.linalg.norm(res):.3e}); "

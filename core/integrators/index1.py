@@ -226,7 +226,7 @@ class _Factor:
         Jd = self.J.toarray() if sp.issparse(self.J) else np.asarray(self.J, float)
         Gd = self.G.toarray() if sp.issparse(self.G) else np.asarray(self.G, float)
         K = np.block([[Md, Gd.T], [Jd, np.zeros((self.n_c, self.n_c))]])
-        sol, *_ = sla.lstsq(K, np.concatenate([f, g]), lapack_driver="gelsd")
+        sol, *_ = sla.lstsq(K, np.concatenate([f, g]), cond=1e-12, lapack_driver="gelsd")
         return sol[:n_v], sol[n_v:]
 
 

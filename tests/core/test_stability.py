@@ -278,11 +278,7 @@ def _check_minimum_norm(m):
     return a1, lam1, J
 
 
-@pytest.mark.parametrize("case", ["bricard", pytest.param("spatial four-bar", marks=pytest.mark.xfail(strict=True, reason=(
-    "BUG (core/dynamics.solve_kkt, minimum_norm path): scipy lstsq(gelsd) is called with the default "
-    "cutoff rcond = eps, so one of the three exact null directions of the KKT matrix (singular value "
-    "7e-15) is counted as rank; the returned λ has a 0.058 component in null(Φ_qᵀ) (‖λ‖ = 4.7652 vs "
-    "minimum norm 4.7647). Fix: pass cond ≈ 1e-12 (relative) or project λ onto range(Φ_q)")))])
+@pytest.mark.parametrize("case", ["bricard", "spatial four-bar"])
 def test_redundant_constraints_detected_named_and_multipliers_minimum_norm(case):
     if case == "bricard":
         with pytest.warns(UserWarning, match="redundant"):
@@ -352,12 +348,6 @@ def test_bricard_runs_with_kept_redundant_equation_hem4():
     assert np.all(np.isfinite(r.lam))
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "BUG (core/dynamics.solve_kkt / index1 SaddleSolver 'lstsq' mode): with redundant='keep' the "
-    "index-1 methods stop after ~0.19 s with 'SingularKKTError: KKT system singular and inconsistent "
-    "(residual 2.6e-05)': once the state drifts by O(tol) off the manifold, γ leaves range(Φ_q) and the "
-    "least-squares solve is rejected instead of returning the minimum-norm solution; generalized-alpha "
-    "and radau-ggl fail at the first step (singular iteration matrix) for the same model"))
 @pytest.mark.parametrize("method", ["rk45-projection"])
 def test_bricard_runs_with_kept_redundant_equation_index1(method):
     m = _quiet(iftomm_a04_bricard, redundant="keep")

@@ -239,3 +239,10 @@ SCENES = [
 
 for _s in SCENES:
     register_scene(_s)
+
+# the work-precision report is part of the main job (issue: "the README's main command includes
+# the work-precision report"); it lives in core.workprecision
+from .workprecision import work_precision_scenes  # noqa: E402
+
+for _s in work_precision_scenes():
+    register_scene(_s)

@@ -253,20 +253,38 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
         if bar is not None:
             bar.update(integ.t - integ.t_old)
         if k < len(t_eval) and t_eval[k] <= integ.t + 1e-12 * max(1.0, abs(integ.t)):
-            dense = integ.dense_output()
+            try:
+                dense = integ.dense_output()
+            except (np.linalg.LinAlgError, FloatingPointError, ArithmeticError, ValueError) as exc:
+                integ.status = STATUS_FAILED
+                integ.message = (f"{integ.name} failed at t = {integ.t:.6g} s: dense output could not be "
+                                 f"built ({type(exc).__name__}: {exc})")
+                break
             while k < len(t_eval) and t_eval[k] <= integ.t + 1e-12 * max(1.0, abs(integ.t)):
                 tk = t_eval[k]
                 if abs(tk - integ.t) <= 1e-12 * max(1.0, abs(integ.t)):
                     q, v = integ.q.copy(), integ.v.copy()
                     lam = None if integ.lam is None else np.array(integ.lam)
                 else:
-                    q, v = dense(tk)
+                    try:
+                        q, v = dense(tk)
+                    except (np.linalg.LinAlgError, FloatingPointError, ArithmeticError, ValueError) as exc:
+                        integ.status = STATUS_FAILED
+                        integ.message = (f"{integ.name} failed at t = {tk:.6g} s: dense output could not be "
+                                         f"evaluated ({type(exc).__name__}: {exc})")
+                        break
+                    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+                        integ.status = STATUS_FAILED
+                        integ.message = f"{integ.name} failed at t = {tk:.6g} s: dense output is not finite"
+                        break
                     lam = None
                 ts.append(tk)
                 qs.append(q)
                 vs.append(v)
                 lams.append(lam)
                 k += 1
+            if integ.status == STATUS_FAILED:
+                break
     if bar is not None:
         bar.close()
     wall = _time.perf_counter() - wall0

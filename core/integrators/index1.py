@@ -167,7 +167,9 @@ class _Factor:
                         self.MGt = owner._Minv_dense @ Gd.T
                     Sd = Jd @ self.MGt
                     if symmetric:
-                        self.fac = sla.cho_factor(Sd, check_finite=True)
+                        if not np.all(np.isfinite(Sd)):
+                            raise np.linalg.LinAlgError("non-finite Schur complement")
+                        self.fac = sla.cho_factor(Sd, check_finite=False)
                         self.mode = "chol"
                     else:
                         lu = sla.lu_factor(Sd, check_finite=True)
@@ -200,6 +202,8 @@ class _Factor:
         n_v = len(f)
         mode = self.mode
         if mode == "free":
+            if self.owner._minv_diag is not None:  # constant diagonal M: cached inverse
+                return self.owner._minv_diag * f, np.zeros(0)
             Md = self.M.toarray() if sp.issparse(self.M) else np.asarray(self.M)
             return np.linalg.solve(Md, f), np.zeros(0)
         Minv = self.owner._Minv

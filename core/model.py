@@ -352,11 +352,35 @@ class ModelBuilder:
             model = _assemble(model)
         model._check_initial(tol)
         model._check_redundancy(redundant, tol)
+        model._freeze()
         return model
 
 
 class Model(ConstrainedSystem):
-    """Frozen Cartesian multibody model (see module docstring). Create with :class:`ModelBuilder`."""
+    """Frozen Cartesian multibody model (see module docstring). Create with :class:`ModelBuilder`.
+
+    After ``build()`` the model is immutable: assigning an attribute raises ``AttributeError``
+    (change the builder and build again; :meth:`with_state` returns a copy with another initial
+    state).  Arrays handed out (``q0``, ``v0``) are read-only views.
+    """
+
+    _frozen = False
+
+    def _freeze(self) -> None:
+        for name in ("q0", "v0", "gravity"):
+            arr = np.array(getattr(self, name), dtype=float)
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        object.__setattr__(self, "_frozen", True)
+
+    def __setattr__(self, name, value):
+        if self._frozen:
+            raise AttributeError(f"model {self.name!r} is frozen: cannot set {name!r} "
+                                 "(change the ModelBuilder and build again, or use with_state())")
+        object.__setattr__(self, name, value)
+
+    def __setstate__(self, state):
+        object.__setattr__(self, "__dict__", dict(state))  # own dict (copy.copy passes the original)
 
     # ---------------------------------------------------------------------------------------
     @classmethod
@@ -540,6 +564,21 @@ class Model(ConstrainedSystem):
             return self.body_names.index(name)
         except ValueError:
             raise ModelError(f"model {self.name!r} has no body {name!r}") from None
+
+    def point_position(self, q: Array, body: str, point) -> Array:
+        """Global position [m] of a body-fixed point given in body coordinates, shape (d,).
+
+        ``q`` may also be a time history of shape (n_t, n_q); the result is then (n_t, d).
+        """
+        k = self.body_index(body)
+        s = np.asarray(point, float).reshape(self.space.dim)
+        Q = np.atleast_2d(np.asarray(q, float))
+        out = np.array([self.body_states(qq).point(np.array([k]), s[None])[0] for qq in Q])
+        return out[0] if np.ndim(q) == 1 else out
+
+    def body_frame(self, q: Array, body: str) -> Array:
+        """Rotation matrix (body → global) of ``body`` at ``q``, shape (d, d)."""
+        return self.body_states(q).A[self.body_index(body)].copy()
 
     def q_slice(self, body: str) -> slice:
         k = self.body_index(body)
@@ -868,6 +907,9 @@ class Model(ConstrainedSystem):
         import copy
 
         m = copy.copy(self)
+        object.__setattr__(m, "_frozen", False)
         m.q0 = np.asarray(q0, float).copy()
         m.v0 = np.asarray(v0, float).copy()
+        if self._frozen:
+            m._freeze()
         return m

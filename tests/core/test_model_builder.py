@@ -311,3 +311,41 @@ def test_pickle_round_trip_same_Phi_and_Q():
         np.testing.assert_array_equal(m2.gamma(t, q, v), m.gamma(t, q, v))
     assert m2.constraint_names == m.constraint_names
     assert m2.energy(0.0, q, v) == m.energy(0.0, q, v)
+
+
+def test_built_model_is_frozen():
+    """build() returns an immutable model: attributes and initial-state arrays cannot be changed;
+    with_state() returns a frozen copy and leaves the original untouched."""
+    import numpy as np
+
+    from core import models
+
+    m = models.simple_pendulum()
+    with pytest.raises(AttributeError, match="frozen"):
+        m.gravity = np.zeros(2)
+    with pytest.raises(ValueError):
+        m.q0[0] = 1.0
+    q0 = m.q0.copy()
+    m2 = m.with_state(q0 + 0.0, m.v0 + 1.0)
+    assert m2._frozen and m._frozen
+    assert np.array_equal(m.q0, q0) and not np.array_equal(m2.v0, m.v0)
+
+
+def test_body_fixed_points_and_frames():
+    """Body-fixed points and frames: the tip of the pendulum rod is at l(sin θ, −cos θ)."""
+    import numpy as np
+
+    from core import models
+
+    m = models.simple_pendulum(length=1.0, angle0=0.3, bob="rod")
+    (body,) = m.body_names
+    A = m.body_frame(m.q0, body)
+    assert np.allclose(A.T @ A, np.eye(2))
+    # the rod's centre of mass is at mid-length; its far end is l/2 further along the rod
+    com = m.q0[:2]
+    axis = com / np.linalg.norm(com)
+    tip_local = A.T @ (axis * 0.5)
+    tip = m.point_position(m.q0, body, tip_local)
+    assert np.allclose(tip, [np.sin(0.3), -np.cos(0.3)], atol=1e-12)
+    hist = m.point_position(np.stack([m.q0, m.q0]), body, tip_local)
+    assert hist.shape == (2, 2)

@@ -500,6 +500,42 @@ def _max_abs_q_error(system, q, v, q_ref) -> float:
     return float(np.max(np.abs(np.asarray(q, float) - q_ref)))
 
 
+def _andrews_cartesian_system():
+    from .models import andrews_cartesian
+
+    return andrews_cartesian()
+
+
+def _andrews_cartesian_error(system, q, v, q_ref) -> float:
+    """Max-abs error of the seven angles recovered from the Cartesian state [rad]."""
+    from .models import andrews_angles_from_cartesian
+
+    return float(np.max(np.abs(andrews_angles_from_cartesian(system, np.asarray(q, float)) - q_ref)))
+
+
+A02_T_END = 1.0
+
+
+def _a02_system():
+    from .models import iftomm_a02_four_bar_chain
+
+    return iftomm_a02_four_bar_chain(n_windows=40, redundant="keep")
+
+
+def _a02_reference() -> float:
+    """Bar angle φ(t_end) [rad] of the equivalent pendulum (minimal coordinate, DOP853 1e-12)."""
+    from .models import iftomm_a02_reference
+
+    phi, _ = iftomm_a02_reference(np.array([0.0, A02_T_END]), n_windows=40)
+    return float(phi[-1])
+
+
+def _a02_error(system, q, v, phi_ref) -> float:
+    """|φ − φ_ref| [rad] of the first bar (body 'bar0'), through its passage of the horizontal."""
+    k = system.body_index("bar0")
+    return float(abs(np.angle(np.exp(1j * (q[3 * k + 2] - phi_ref)))))
+
+
 # ---------------------------------------------------------------------------------------------
 # the registry
 # ---------------------------------------------------------------------------------------------
@@ -590,6 +626,38 @@ def _build_registry() -> None:
         grids={"quick": Grid(rtols=(1e-4,), steps=(3e-5,), methods=_QUICK_METHODS),
                "standard": Grid(rtols=(1e-3, 1e-5, 1e-7), steps=(1e-4, 3e-5, 1e-5), exclude=_STD_EXCLUDE),
                "full": Grid(rtols=_geom(1e-3, 1e-10, 1), steps=_geom(1e-4, 1e-6, 2))},
+    ))
+    register_problem(WorkPrecisionProblem(
+        name="andrews-cartesian",
+        title="Andrews' squeezing mechanism as a Cartesian model of the same seven bodies (t = 0.03 s)",
+        build_system=_andrews_cartesian_system,
+        t_end=0.03,
+        reference_fn=_andrews_reference,
+        error_fn=_andrews_cartesian_error,
+        error_measure="max_k |angle_k - angle_k,ref| over the 7 angles [rad]",
+        reference_note=("published solution at t = 0.03 s (Test Set for IVP Solvers 2.4, andrews.f), compared "
+                        "through core.models.andrews_angles_from_cartesian"),
+        conservative=True,
+        grids={"quick": Grid(rtols=(1e-4,), steps=(3e-5,), methods=_QUICK_METHODS),
+               "standard": Grid(rtols=(1e-3, 1e-5, 1e-7), steps=(1e-4, 3e-5, 1e-5), exclude=_STD_EXCLUDE),
+               "full": Grid(rtols=_geom(1e-3, 1e-10, 1), steps=_geom(1e-4, 1e-6, 2))},
+    ))
+    register_problem(WorkPrecisionProblem(
+        name="iftomm-a02",
+        title="IFToMM A02: 40-window four-bar chain through its singular (horizontal) configuration, t = 1 s",
+        build_system=_a02_system,
+        t_end=A02_T_END,
+        reference_fn=_a02_reference,
+        error_fn=_a02_error,
+        error_measure="|phi - phi_ref| of bar 0 [rad]",
+        reference_note=("equivalent-pendulum ODE [(N+1)/3 + N] L phi'' = -g cos(phi) [(N+1)/2 + N] integrated by "
+                        "DOP853 at 1e-12 (core.models.iftomm_a02_reference); the bars pass the horizontal at "
+                        "t = 0.72 s, where the number of degrees of freedom jumps"),
+        conservative=True,
+        grids={"quick": Grid(rtols=(1e-4,), steps=(2e-3,), methods=("rk45-projection", "generalized-alpha")),
+               "standard": Grid(rtols=(1e-4, 1e-6), steps=(4e-3, 2e-3, 1e-3),
+                                methods=("rk45-projection", "dop853-projection", "radau-ggl", "generalized-alpha")),
+               "full": Grid(rtols=_geom(1e-3, 1e-8, 1), steps=_geom(4e-3, 2.5e-4, 2))},
     ))
     register_problem(WorkPrecisionProblem(
         name="car-axis",

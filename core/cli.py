@@ -164,6 +164,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         code = func(args)
     except SystemExit as exc:  # parser.error() inside a command
         return exc.code if isinstance(exc.code, int) else EXIT_USAGE
+    except (ValueError, TypeError, FileNotFoundError) as exc:
+        # bad input (a value, a file): the message names it; no traceback for the user
+        print(f"mbsuite: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
     return EXIT_OK if code is None else int(code)
 
 

@@ -206,3 +206,31 @@ def test_registered_command_plugins_load():
         if importlib.util.find_spec(module.split(".")[0]) is None or importlib.util.find_spec(module) is None:
             continue  # the plug-in's package is still being written
         assert callable(ep.load()), ep
+
+
+def test_bad_input_in_a_command_is_reported_without_traceback(capsys):
+    """A ValueError raised by a command (bad value or file) becomes one line naming it, exit 2."""
+    import argparse
+
+    from core import cli
+
+    def boom(args):
+        raise ValueError("rail inclination -0.025 (given as '-1:40') is negative")
+
+    parser = cli.build_parser()
+    original = parser.parse_args
+
+    def parse(argv=None):
+        return argparse.Namespace(func=boom)
+
+    parser.parse_args = parse
+    orig_build = cli.build_parser
+    cli.build_parser = lambda: parser
+    try:
+        code = cli.main([])
+    finally:
+        cli.build_parser = orig_build
+        parser.parse_args = original
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "mbsuite: error: rail inclination -0.025" in err and "Traceback" not in err

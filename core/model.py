@@ -602,18 +602,21 @@ class Model(ConstrainedSystem):
         return out
 
     def Z(self, q: Array):
+        """``Z(q)``: identity for planar bodies; ``diag(I₃, ½L(p)ᵀ)`` per spatial body (one COO build)."""
         if self.space.dim == 2:
             return sp.identity(self.n_q, format="csr")
-        nb = self.n_bodies
-        L = frames.euler_rate_matrix(q[: nb * 7].reshape(nb, 7)[:, 3:])
-        blocks = []
-        for k in range(nb):
-            blk = np.zeros((7, 6))
-            blk[:3, :3] = np.eye(3)
-            blk[3:, 3:] = 0.5 * L[k].T
-            blocks.append(blk)
-        blocks += [np.eye(1)] * len(self.extra_names)
-        return sp.block_diag(blocks, format="csr")
+        nb, ne = self.n_bodies, len(self.extra_names)
+        blk = np.zeros((nb, 7, 6))
+        blk[:, :3, :3] = np.eye(3)
+        blk[:, 3:, 3:] = 0.5 * np.swapaxes(frames.euler_rate_matrix(q[: nb * 7].reshape(nb, 7)[:, 3:]), 1, 2)
+        b = np.arange(nb)[:, None, None]
+        rows = np.broadcast_to(b * 7 + np.arange(7)[None, :, None], blk.shape).ravel()
+        cols = np.broadcast_to(b * 6 + np.arange(6)[None, None, :], blk.shape).ravel()
+        ex = np.arange(ne)
+        data = np.concatenate([blk.ravel(), np.ones(ne)])
+        rows = np.concatenate([rows, nb * 7 + ex])
+        cols = np.concatenate([cols, nb * 6 + ex])
+        return sp.csr_matrix((data, (rows, cols)), shape=(self.n_q, self.n_v))
 
     def retract(self, q: Array, dv: Array) -> Array:
         if self.space.dim == 2:

@@ -349,3 +349,19 @@ def test_body_fixed_points_and_frames():
     assert np.allclose(tip, [np.sin(0.3), -np.cos(0.3)], atol=1e-12)
     hist = m.point_position(np.stack([m.q0, m.q0]), body, tip_local)
     assert hist.shape == (2, 2)
+
+
+def test_kinematic_matrix_Z_maps_velocities_to_coordinate_rates():
+    """q̇ = Z(q) v: the sparse Z of a spatial model equals the vectorised qdot, and ω̄ = 2 L ṗ."""
+    import numpy as np
+
+    from core import frames, models
+
+    m = models.n_link_chain(3, spatial=True)
+    rng = np.random.default_rng(7)
+    q = m.retract(m.q0, 0.1 * rng.standard_normal(m.n_v))
+    v = rng.standard_normal(m.n_v)
+    qd = m.Z(q) @ v
+    np.testing.assert_allclose(qd, m.qdot(q, v), atol=1e-15)
+    p, pdot = q[3:7], qd[3:7]
+    np.testing.assert_allclose(2.0 * frames.euler_rate_matrix(p) @ pdot, v[3:6], atol=1e-12)

@@ -205,11 +205,7 @@ def _scale(q: Array) -> float:
 
 
 def _q_jacobians(system: ConstrainedSystem, t: float, q: Array, v: Array) -> tuple[Array, Array]:
-    f = getattr(system, "Q_jacobians", None)
-    if f is not None:
-        Qq, Qv = f(t, q, v)
-    else:
-        Qq, Qv = system.Q_q(t, q, v), system.Q_v(t, q, v)
+    Qq, Qv = system.Q_jacobians(t, q, v)
     return as_dense(Qq), as_dense(Qv)
 
 

@@ -150,6 +150,10 @@ class ConstrainedSystem(ABC):
             J[:, k] = (self.Q(t, q, vv) - Q0) / h
         return J
 
+    def Q_jacobians(self, t: float, q: Array, v: Array):
+        """Both ``(Q_q, Q_v)``; systems with analytic Jacobians override this with one pass."""
+        return self.Q_q(t, q, v), self.Q_v(t, q, v)
+
     # --- diagnostics ----------------------------------------------------------------------
     def energy(self, t: float, q: Array, v: Array) -> float | None:
         """Total mechanical energy [J] where defined (kinetic + potential), else None."""

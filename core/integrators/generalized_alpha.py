@@ -190,11 +190,7 @@ def q_magnitude(system, q: np.ndarray) -> np.ndarray:
 
 def q_jacobians(system, t, q, v):
     """``(Q_q, Q_v)`` as sparse matrices (the system's one-pass evaluator when it has one)."""
-    f = getattr(system, "Q_jacobians", None)
-    if f is not None:
-        Kq, Kv = f(t, q, v)
-    else:
-        Kq, Kv = system.Q_q(t, q, v), system.Q_v(t, q, v)
+    Kq, Kv = system.Q_jacobians(t, q, v)
     return _sparse(Kq), _sparse(Kv)
 
 

@@ -21,6 +21,7 @@ and the energy drift as :math:`E(t_k) - E(t_0)`, made relative by
 
 from __future__ import annotations
 
+import functools
 import importlib.metadata
 import re
 from dataclasses import dataclass, field
@@ -111,6 +112,12 @@ def environment_versions() -> dict[str, str]:
     dict of str to str
         Package name -> version; ``"unknown"`` for mbsuite when it is not installed.
     """
+    return dict(_environment_versions())
+
+
+@functools.lru_cache(maxsize=1)
+def _environment_versions() -> dict[str, str]:
+    """Looked up once per process (the package metadata query costs ~1 ms per result otherwise)."""
     import platform
 
     import scipy

@@ -21,7 +21,9 @@ and records, per run, one row of a tidy table:
   ``status`` and ``message``.
 
 A run that fails (status ``"failed"``, or an exception while setting it up) stays in the table
-as a row with ``status = "failed"``, the message, and ``error = NaN``; nothing is dropped.
+as a row with ``status = "failed"``, the message, and ``error = NaN``; nothing is dropped.  Only
+a method that cannot integrate the system at all (:meth:`Integrator.applicable` gives a reason,
+e.g. a compiled integrator on a hand-written system) is left out of the problem's table.
 
 Settings
 --------
@@ -100,6 +102,8 @@ __all__ = [
 
 SETTING_RTOL = "rtol"
 SETTING_STEP = "h [s]"
+#: Row status of a method that cannot integrate the problem's system (dropped from the tables).
+NOT_APPLICABLE = "not applicable"
 COUNTERS = ("n_steps", "n_rejected", "n_rhs", "n_jac", "n_factor", "n_newton")
 
 #: Columns of the table returned by :func:`run_work_precision`, in order.
@@ -762,6 +766,11 @@ def _run_case(case: _Case) -> dict[str, Any]:
     except Exception as exc:  # noqa: BLE001 - reported in the row
         row["message"] = f"building the system failed: {type(exc).__name__}: {exc}"
         return row
+    reason = _load_integrators()[case.method].applicable(system)
+    if reason is not None:
+        row["status"] = NOT_APPLICABLE
+        row["message"] = reason
+        return row
     options = dict(prob.method_options.get(case.method, {}))
     t_eval = np.linspace(0.0, prob.t_end, prob.n_output)
     walls: list[float] = []
@@ -899,7 +908,8 @@ def run_work_precision(problem: str | WorkPrecisionProblem, methods: str | Seque
 
 
 def _frame(prob: WorkPrecisionProblem, grid: Grid, rows: list[dict]) -> pd.DataFrame:
-    df = pd.DataFrame(rows, columns=COLUMNS)
+    # methods that cannot integrate this system at all (Integrator.applicable) are left out of the table
+    df = pd.DataFrame([r for r in rows if r["status"] != NOT_APPLICABLE], columns=COLUMNS)
     for c in (*COUNTERS, "n repeats"):
         df[c] = df[c].astype(int)
     df.attrs.update(problem=prob.name, title=prob.title, error_measure=prob.error_measure,

@@ -73,6 +73,9 @@ class Integrator:
     fixed_step: bool = False
     #: The method produces consistent multipliers itself (else simulate() computes them).
     provides_multipliers: bool = False
+    #: Steps land on requested output times: :func:`simulate` calls :meth:`advance` with the next
+    #: output time instead of :meth:`step` + dense output (compiled loops that take many steps per call).
+    steps_to_output: bool = False
 
     def __init__(self, system: ConstrainedSystem, t_span, q0=None, v0=None, *, rtol: float = 1e-6,
                  atol: float = 1e-8, h: float | None = None, max_step: float = np.inf, **options):
@@ -107,6 +110,11 @@ class Integrator:
         """Names of the method-specific keyword options."""
         return ()
 
+    @classmethod
+    def applicable(cls, system: ConstrainedSystem) -> str | None:
+        """``None`` when the method can integrate ``system``, else the reason (e.g. no compiled kernel)."""
+        return None
+
     # --- template method --------------------------------------------------------------------
     def step(self) -> str | None:
         """Advance one step; returns the message if the run ended in failure, else None."""
@@ -134,6 +142,14 @@ class Integrator:
             self.status = STATUS_FINISHED
             self.message = "reached the end of the time span"
         return None
+
+    def advance(self, t_target: float) -> str | None:
+        """Advance towards ``t_target``; the default takes one :meth:`step` (may pass ``t_target``).
+
+        Methods with ``steps_to_output = True`` take as many steps as needed and land on
+        ``min(t_target, t_end)`` exactly.
+        """
+        return self.step()
 
     def _step_impl(self) -> tuple[bool, str | None]:  # pragma: no cover - abstract
         raise NotImplementedError
@@ -246,7 +262,10 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
         k += 1
     while integ.status == STATUS_RUNNING:
         s0 = _time.perf_counter()
-        integ.step()
+        if integ.steps_to_output:
+            integ.advance(t_eval[k] if k < len(t_eval) else t_end)
+        else:
+            integ.step()
         solve_time += _time.perf_counter() - s0
         if integ.status == STATUS_FAILED:
             break

@@ -27,7 +27,11 @@ for the tip error at t = 1 s to be at most ``1e-6`` m.
   (default 3), round-robin over all configurations of the case (so slow drifts of machine load
   hit every tool alike); the figure is the median wall time of the solve alone (model building
   excluded: ``simulate(...)`` for mbsuite including its set-up and a single output point,
-  ``mbs.SolveDynamic`` for Exudyn, ``solve_ivp`` for the baseline).
+  ``mbs.SolveDynamic`` for Exudyn, ``solve_ivp`` for the baseline).  The compiled integrators
+  (``jit-*``) pay their one-time costs in the screening run that precedes the timed repeats:
+  loading the numba kernels from the on-disk cache (compiling them on the very first use) and
+  packing the model into flat arrays (``core.compiled.compile_model``, cached per model — model
+  set-up, like Exudyn's ``Assemble``, which is outside its timed region too).
 * One process, one thread (``OMP_NUM_THREADS`` etc. = 1 before numpy is imported).
 * Ratio vs Exudyn = (mbsuite best median) / (Exudyn best median); ratio vs baseline likewise.
   Target of the issue: ratio vs Exudyn ≤ 1.0.  The same ratio on process CPU time

@@ -540,6 +540,49 @@ def _a02_error(system, q, v, phi_ref) -> float:
     return float(abs(np.angle(np.exp(1j * (q[3 * k + 2] - phi_ref)))))
 
 
+A04_T_END = 10.0
+A04_REFERENCE_TOL = 1e-12
+
+
+def _a04_system():
+    """Bricard's mechanism with its one dependent equation removed (named by ``build``)."""
+    from .models import iftomm_a04_bricard
+
+    with warnings.catch_warnings():  # the redundancy warning is the expected, documented one
+        warnings.simplefilter("ignore", UserWarning)
+        return iftomm_a04_bricard(redundant="remove")
+
+
+def _a04_tip(system, q) -> np.ndarray:
+    """Global position [m] of P2 = (1, −1, 0) m at t = 0, the joint J3 end of rod2."""
+    k = system.body_index("rod2")
+    q0 = system.q0
+    r0 = q0[7 * k:7 * k + 3]
+    s = system.body_frame(q0, "rod2").T @ (np.array([1.0, -1.0, 0.0]) - r0)
+    return system.point_position(q, "rod2", s)
+
+
+def _a04_reference() -> np.ndarray:
+    """P2 at t = 10 s by the compiled DOP853 with coordinate projection at rtol = atol = 1e-12.
+
+    A converged solution of the same Cartesian model, as the IFToMM library's references are; it is
+    cross-checked in ``tests/core/test_workprecision.py`` (slow) against scipy's DOP853 with
+    projection driving the numpy right-hand side, and against energy conservation.
+    """
+    from .integrators import simulate
+
+    system = _a04_system()
+    res = simulate(system, (0.0, A04_T_END), "jit-dop853-projection", t_eval=[A04_T_END], rtol=A04_REFERENCE_TOL,
+                   atol=A04_REFERENCE_TOL, compute_multipliers=False)
+    if res.status != "finished":  # pragma: no cover - the reference run is deterministic
+        raise RuntimeError(f"A04 reference run failed: {res.message}")
+    return _a04_tip(system, res.q[-1])
+
+
+def _a04_error(system, q, v, ref) -> float:
+    return float(np.linalg.norm(_a04_tip(system, q) - ref))
+
+
 # ---------------------------------------------------------------------------------------------
 # the registry
 # ---------------------------------------------------------------------------------------------
@@ -548,11 +591,11 @@ def _a02_error(system, q, v, phi_ref) -> float:
 #: Baumgarte index-1 variants (their projected counterparts stay) and LSODA (it restarts
 #: after every projection, see core.integrators.index1).  Patterns, so integrators registered
 #: later are included by default.
-_STD_EXCLUDE = ("rk45", "dop853", "radau", "bdf", "lsoda*", "*-baumgarte")
+_STD_EXCLUDE = ("rk45", "dop853", "radau", "bdf", "lsoda*", "*-baumgarte", "jit-rk45", "jit-dop853")
 #: For unconstrained (stiff spring) problems projection and Baumgarte change nothing.
 _ODE_EXCLUDE = ("*-projection", "*-baumgarte", "lsoda*")
-_QUICK_METHODS = ("rk45-projection", "dop853-projection", "radau-projection", "generalized-alpha", "radau-ggl",
-                  "hem4")
+_QUICK_METHODS = ("rk45-projection", "dop853-projection", "jit-dop853-projection", "radau-projection",
+                  "generalized-alpha", "radau-ggl", "hem4")
 
 _CHAIN_NOTE = ("minimal-coordinate ODE of the chain (absolute link angles), scipy DOP853 at rtol = atol = "
                "1e-13 (core.models.n_link_chain_reference; core_benchmarks.md §1)")
@@ -568,7 +611,7 @@ def _chain_grids(n: int, spatial: bool) -> dict[str, Grid]:
         quick = Grid(rtols=(1e-4, 1e-7), steps=(3e-3,), methods=_QUICK_METHODS)
     else:
         std = Grid(rtols=(1e-4, 1e-6), steps=(1e-3,),
-                   methods=("dop853-projection", "generalized-alpha", "hem4"))
+                   methods=("dop853-projection", "jit-dop853-projection", "generalized-alpha", "hem4"))
         quick = Grid(rtols=(1e-5,), steps=(1e-3,), methods=("dop853-projection", "generalized-alpha"))
     return {"quick": quick, "standard": std, "full": full}
 
@@ -664,6 +707,24 @@ def _build_registry() -> None:
                "full": Grid(rtols=_geom(1e-3, 1e-8, 1), steps=_geom(4e-3, 2.5e-4, 2))},
     ))
     register_problem(WorkPrecisionProblem(
+        name="iftomm-a04",
+        title="IFToMM A04: Bricard's over-constrained 6R mechanism under gravity (dependent row removed), t = 10 s",
+        build_system=_a04_system,
+        t_end=A04_T_END,
+        reference_fn=_a04_reference,
+        error_fn=_a04_error,
+        error_measure="|P2 - P2_ref|, P2 the rod2/rod3 joint (1, -1, 0) m at t = 0 [m]",
+        reference_note=(f"converged run of the same model: compiled DOP853 with coordinate projection at rtol = atol "
+                        f"= {A04_REFERENCE_TOL:g}, cross-checked against scipy DOP853 + projection on the numpy "
+                        "right-hand side (tests); energy is conserved (IFToMM A04)"),
+        conservative=True,
+        grids={"quick": Grid(rtols=(1e-5,), steps=(1e-2,), methods=("jit-dop853-projection", "generalized-alpha")),
+               "standard": Grid(rtols=(1e-4, 1e-6, 1e-8), steps=(1e-2, 3e-3),
+                                methods=("dop853-projection", "jit-dop853-projection", "jit-rk45-projection",
+                                         "radau-ggl", "generalized-alpha")),
+               "full": Grid(rtols=_geom(1e-3, 1e-10, 1), steps=_geom(1e-2, 1e-3, 2))},
+    ))
+    register_problem(WorkPrecisionProblem(
         name="car-axis",
         title="Car axis, index-3 stiff DAE with a moving support (t = 3)",
         build_system=_car_axis_system,
@@ -707,7 +768,8 @@ PROBLEM_SETS: dict[str, list[str]] = {
     # chain*-stiff-k1e8 is in "full" only: its resolved reference alone takes 1-2 min (DOP853 must
     # follow the undamped 2.8e4 rad/s spring oscillation at 1e-12)
     "standard": ["chain2-planar", "chain8-planar", "chain2-spatial", "chain32-planar",
-                 "chain2-stiff-k1e4", "chain2-stiff-k1e6", "andrews", "car-axis", "pendulum-100s"],
+                 "chain2-stiff-k1e4", "chain2-stiff-k1e6", "chain8-stiff-k1e6", "andrews", "car-axis",
+                 "pendulum-100s", "iftomm-a04"],
 }
 
 

@@ -825,12 +825,12 @@ def project(cd, ws, q, v, tol, max_iter, counters):
     if m == 0:
         return 0
     zero_v = ws.tmp_v
-    body_states(cd, q, v, ws)
-    constraint_terms(cd, ws, True, False)
+    _body_states_ool(cd, q, v, ws)
+    _constraint_terms_ool(cd, ws, True, False)
     err = _max_abs_phi(cd, ws)
     n_iter = 0
     if err > tol:
-        if factor_schur(cd, ws) != OK:
+        if _factor_schur_ool(cd, ws) != OK:
             return -1
         counters[3] += 1
         prev = np.inf
@@ -839,7 +839,7 @@ def project(cd, ws, q, v, tol, max_iter, counters):
             for k in range(m):
                 a = cd.act[k]
                 rhs[cd.perm_of_row[a]] = ws.phi[a]
-            solve_schur(cd, ws, rhs)
+            _solve_schur_ool(cd, ws, rhs)
             for i in range(cd.n_v):
                 zero_v[i] = 0.0
             _subtract_X_mu(ws.X, cd.r_b, cd.act, cd.perm_of_row, cd.nb, cd.nvb, rhs, zero_v)  # Δ = −M⁻¹ Φ_qᵀ S⁻¹ Φ
@@ -855,16 +855,16 @@ def project(cd, ws, q, v, tol, max_iter, counters):
             prev = err
         normalize(cd, q)
     # velocities at the projected positions
-    body_states(cd, q, v, ws)
-    constraint_terms(cd, ws, False, False)
-    if factor_schur(cd, ws) != OK:
+    _body_states_ool(cd, q, v, ws)
+    _constraint_terms_ool(cd, ws, False, False)
+    if _factor_schur_ool(cd, ws) != OK:
         return -1
     counters[3] += 1
     rhs = ws.rhs
     for k in range(m):
         a = cd.act[k]
         rhs[cd.perm_of_row[a]] = _rows_dot(ws.G, cd.r_b, cd.nb, cd.nvb, v, a)
-    solve_schur(cd, ws, rhs)
+    _solve_schur_ool(cd, ws, rhs)
     _subtract_X_mu(ws.X, cd.r_b, cd.act, cd.perm_of_row, cd.nb, cd.nvb, rhs, v)
     return n_iter
 
@@ -946,3 +946,11 @@ def _constraint_phi(cd, ws):
             tj = np.arctan2(A[bj, 1, 0], A[bj, 0, 0])
             x = tj - ti - cd.c_scalar[e]
             phi[r0] = np.arctan2(np.sin(x), np.cos(x))
+
+
+# Out-of-line twins of the inlined kernels for the projection: it runs once per step, so a call
+# boundary costs nothing there, and not inlining everything into it saves compile time.
+_body_states_ool = _jit(body_states.py_func)
+_constraint_terms_ool = _jit(constraint_terms.py_func)
+_factor_schur_ool = _jit(factor_schur.py_func)
+_solve_schur_ool = _jit(solve_schur.py_func)

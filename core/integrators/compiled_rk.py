@@ -79,12 +79,6 @@ def _rhs(cd, ws, t, y, alpha, beta, out, lam, counters):
     return st
 
 
-@_jit
-def _rhs_call(cd, ws, t, y, alpha, beta, out, lam, counters):
-    """Out-of-line :func:`_rhs` for the rare call sites (set-up, after a projection)."""
-    return _rhs(cd, ws, t, y, alpha, beta, out, lam, counters)
-
-
 @_jit_inline
 def _rms(e, y, y_new, rtol, atol):
     acc = 0.0
@@ -96,44 +90,14 @@ def _rms(e, y, y_new, rtol, atol):
 
 
 @_jit
-def initial_step(cd, ws, t0, y0, f0, t_bound, max_step, order, rtol, atol, alpha, beta, lam, counters, tmp_y, tmp_f):
-    """Hairer–Nørsett–Wanner initial step (the algorithm of scipy's ``select_initial_step``)."""
-    n = y0.shape[0]
-    interval = abs(t_bound - t0)
-    d0 = 0.0
-    d1 = 0.0
-    for i in range(n):
-        sc = atol + abs(y0[i]) * rtol
-        d0 += (y0[i] / sc) ** 2
-        d1 += (f0[i] / sc) ** 2
-    d0 = np.sqrt(d0 / n)
-    d1 = np.sqrt(d1 / n)
-    if d0 < 1e-5 or d1 < 1e-5:
-        h0 = 1e-6
-    else:
-        h0 = 0.01 * d0 / d1
-    h0 = min(h0, interval)
-    for i in range(n):
-        tmp_y[i] = y0[i] + h0 * f0[i]
-    _rhs_call(cd, ws, t0 + h0, tmp_y, alpha, beta, tmp_f, lam, counters)
-    d2 = 0.0
-    for i in range(n):
-        sc = atol + abs(y0[i]) * rtol
-        d2 += ((tmp_f[i] - f0[i]) / sc) ** 2
-    d2 = np.sqrt(d2 / n) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
-    return min(100.0 * h0, h1, interval, max_step)
-
-
-@_jit
-def advance(cd, ws, t, y, f, t_stop, t_bound, h_abs, max_steps, A, B, C, E, E3, E5, err_kind, err_exp,
+def advance(cd, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C, E, E3, E5, err_kind, err_exp,
             rtol, atol, max_step, alpha, beta, projection, proj_tol, max_proj_iter,
             K, y_new, y_old, f_old, tmp, lam, counters, out_info):
     r"""Take accepted steps from ``t`` until ``t_stop`` (or ``max_steps``); ``y``, ``f`` updated in place.
 
+    ``need_f``: evaluate ``f = F(t, y)`` first (initial state, after a projection); with
+    ``max_steps = 0`` that is all it does.  Every right-hand side of the loop goes through one
+    call site, where :func:`_rhs` is inlined (one copy of the kernels to compile).
     ``y_old``/``f_old`` receive the state and derivative at the start of the last accepted step.
     ``out_info = [t, h_abs, t_old, t_fail]``.  Returns an exit code: ``EXIT_REACHED``,
     ``EXIT_MAX_STEPS`` or a failure (kernel status, ``EXIT_TOO_SMALL``).
@@ -142,6 +106,16 @@ def advance(cd, ws, t, y, f, t_stop, t_bound, h_abs, max_steps, A, B, C, E, E3, 
     ns = B.shape[0]
     steps = 0
     while True:
+        if need_f:
+            for i in range(n):
+                tmp[i] = y[i]
+            st = _rhs(cd, ws, t, tmp, alpha, beta, f, lam, counters)
+            need_f = False
+            if st != _c.OK:
+                out_info[0] = t
+                out_info[3] = t
+                return st
+            continue
         if t >= t_stop:
             out_info[0] = t
             out_info[1] = h_abs
@@ -250,14 +224,7 @@ def advance(cd, ws, t, y, f, t_stop, t_bound, h_abs, max_steps, A, B, C, E, E3, 
                 out_info[0] = t
                 out_info[3] = t_new
                 return _c.PROJECTION
-            st = _rhs_call(cd, ws, t_new, y, alpha, beta, f, lam, counters)
-            if st != _c.OK:
-                for i in range(n):
-                    y[i] = y_old[i]
-                    f[i] = f_old[i]
-                out_info[0] = t
-                out_info[3] = t_new
-                return st
+            need_f = True  # f at the projected state, evaluated at the top of the loop
         out_info[2] = t
         t = t_new
         steps += 1
@@ -338,29 +305,63 @@ class CompiledRK(Integrator):
         self._y = np.concatenate([self.q, self.v])
         self._f = np.zeros(n)
         self._y_new, self._y_old, self._f_old, self._tmp = (np.zeros(n) for _ in range(4))
-        self._tmp2 = np.zeros(n)
         self._lam = np.zeros(max(system.n_c, 1))
         self._cnt = np.zeros(4, np.int64)
         self._info = np.zeros(4)
+        self._h_abs = 0.0
         if self.stabilization == "projection":
             nq = system.n_q
             it = _c.project(self._cd, self._ws, self._y[:nq], self._y[nq:], self.projection_tol,
                             self.max_projection_iter, self._cnt)
             if it < 0:
                 raise ValueError(f"{self.name}: initial state of {system.name!r} cannot be projected onto the constraints")
-        st = _rhs_call(self._cd, self._ws, self.t, self._y, self.alpha, self.beta, self._f, self._lam, self._cnt)
+        st = self._evaluate(self.t, self._y, self._f)
         if st != _c.OK:
             raise ValueError(f"{self.name}: right-hand side fails at the initial state of {system.name!r}: "
                              f"{_c.STATUS_MESSAGES[st]}")
         if self.h is not None:
             self._h_abs = min(self.h, self.t_bound - self.t)
         else:
-            self._h_abs = initial_step(self._cd, self._ws, self.t, self._y, self._f, self.t_bound, self.max_step,
-                                       s.error_estimator_order, self.rtol, self.atol, self.alpha, self.beta,
-                                       self._lam, self._cnt, self._tmp, self._tmp2)
+            self._h_abs = self._initial_step(s.error_estimator_order)
         self._sync_counters()
         self.q, self.v = self._y[: system.n_q].copy(), self._y[system.n_q :].copy()
         self.a = self._f[system.n_q :].copy()
+
+    def _advance_kernel(self, t, y, f, need_f, t_stop, max_steps):
+        return advance(self._cd, self._ws, t, y, f, need_f, t_stop, self.t_bound, self._h_abs, max_steps,
+                       self._A, self._B, self._C, self._E, self._E3, self._E5, self._err_kind, self._err_exp,
+                       self.rtol, self.atol, self.max_step, self.alpha, self.beta, self.stabilization == "projection",
+                       self.projection_tol, self.max_projection_iter, self._K, self._y_new, self._y_old,
+                       self._f_old, self._tmp, self._lam, self._cnt, self._info)
+
+    def _evaluate(self, t, y, out):
+        """``out = F(t, y)`` through the compiled loop's right-hand side; kernel status code."""
+        out[:] = 0.0
+        code = self._advance_kernel(float(t), y, out, True, float(t), 0)
+        return _c.OK if code in (EXIT_REACHED, EXIT_MAX_STEPS) else code
+
+    def _initial_step(self, order):
+        """Initial step of Hairer, Nørsett & Wanner I, Sec. II.4 (scipy's ``select_initial_step``)."""
+        t0, y0, f0 = self.t, self._y, self._f
+        interval = abs(self.t_bound - t0)
+        scale = self.atol + np.abs(y0) * self.rtol
+        d0 = float(np.sqrt(np.mean((y0 / scale) ** 2)))
+        d1 = float(np.sqrt(np.mean((f0 / scale) ** 2)))
+        h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+        h0 = min(h0, interval)
+        f1 = np.zeros_like(y0)
+        if self._evaluate(t0 + h0, y0 + h0 * f0, f1) != _c.OK:
+            f1[:] = np.nan
+        d2 = float(np.sqrt(np.mean(((f1 - f0) / scale) ** 2))) / h0
+        if d1 <= 1e-15 and d2 <= 1e-15:
+            h1 = max(1e-6, h0 * 1e-3)
+        else:
+            h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
+        h = min(100.0 * h0, h1, interval, self.max_step)
+        if not np.isfinite(h) or h <= 0:
+            raise ValueError(f"{self.name}: no usable initial step at t = {t0:g} s for {self.system.name!r} "
+                             "(non-finite right-hand side near the initial state)")
+        return h
 
     def _sync_counters(self):
         c = self.counters
@@ -378,11 +379,7 @@ class CompiledRK(Integrator):
         steps0 = int(self._cnt[C_STEPS])
         info = self._info
         info[:] = (self.t, self._h_abs, self.t, np.nan)
-        code = advance(self._cd, self._ws, self.t, self._y, self._f, t_stop, self.t_bound, self._h_abs, max_steps,
-                       self._A, self._B, self._C, self._E, self._E3, self._E5, self._err_kind, self._err_exp,
-                       self.rtol, self.atol, self.max_step, self.alpha, self.beta, self.stabilization == "projection",
-                       self.projection_tol, self.max_projection_iter, self._K, self._y_new, self._y_old,
-                       self._f_old, self._tmp, self._lam, self._cnt, info)
+        code = self._advance_kernel(self.t, self._y, self._f, False, t_stop, max_steps)
         nq = self.system.n_q
         taken = int(self._cnt[C_STEPS]) - steps0
         self.counters["n_steps"] += taken

@@ -123,9 +123,9 @@ CompiledData = namedtuple("CompiledData", [
     "sd_bi", "sd_bj", "sd_si", "sd_sj", "sd_k", "sd_c", "sd_L0",
 ])
 
-Workspace = namedtuple("Workspace", [
-    "r", "A", "rd", "w", "phi", "G", "gam", "X", "S", "L", "Q", "x0", "rhs", "mu", "tmp_v", "tmp_c",
-])
+#: Scratch arrays: body poses r, A (3-D), velocities rd, w; Φ, Φ_q blocks G, γ, M⁻¹Φ_qᵀ blocks X (all
+#: model rows); Schur complement S and its envelope factor L; Q; Schur right-hand side; a velocity vector.
+Workspace = namedtuple("Workspace", ["r", "A", "rd", "w", "phi", "G", "gam", "X", "S", "L", "Q", "rhs", "tmp_v"])
 
 
 # ================================================================================================
@@ -323,8 +323,7 @@ def make_workspace(cd: CompiledData) -> Workspace:
         r=np.zeros((nb + 1, 3)), A=A, rd=np.zeros((nb + 1, 3)), w=np.zeros((nb + 1, 3)),
         phi=np.zeros(m_all), G=np.zeros((m_all, 2, 6)), gam=np.zeros(m_all), X=np.zeros((m_all, 2, 6)),
         S=np.zeros((max(m, 1), max(m, 1))), L=np.zeros((max(m, 1), max(m, 1))), Q=np.zeros(cd.n_v),
-        x0=np.zeros(cd.n_v), rhs=np.zeros(max(m, 1)), mu=np.zeros(max(m, 1)), tmp_v=np.zeros(cd.n_v),
-        tmp_c=np.zeros(max(m_all, 1)),
+        rhs=np.zeros(max(m, 1)), tmp_v=np.zeros(cd.n_v),
     )
 
 

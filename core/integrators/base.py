@@ -232,7 +232,8 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
     conservative systems, the energy are recorded at every output time.
 
     A run that fails (NaN, divergence, unmet tolerance, exception) returns with
-    ``status == "failed"``, the message saying where, and all output computed up to that point.
+    ``status == "failed"``, the message saying where, all output computed up to that point and, as
+    its last row, the last good state at the time where the run stopped.
     """
     from ..results import SimulationResult
 
@@ -306,6 +307,12 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
                 break
     if bar is not None:
         bar.close()
+    if integ.status == STATUS_FAILED and (not ts or integ.t > ts[-1]):
+        # keep what was computed: the last good state, where the run stopped (not a requested time)
+        ts.append(float(integ.t))
+        qs.append(integ.q.copy())
+        vs.append(integ.v.copy())
+        lams.append(None)
     wall = _time.perf_counter() - wall0
     ts = np.array(ts)
     n_t = len(ts)

@@ -60,9 +60,16 @@ _jit_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 ERR_RK45, ERR_DOP853 = 0, 1
 # counters array layout
-C_STEPS, C_REJ, C_RHS, C_FACT = 0, 1, 2, 3
+C_STEPS, C_REJ, C_RHS, C_FACT, C_IASTI, C_NONSTI, C_STIFF = 0, 1, 2, 3, 4, 5, 6
 # loop exit codes (besides the kernel status codes of core.compiled)
-EXIT_REACHED, EXIT_MAX_STEPS, EXIT_TOO_SMALL = 100, 101, 102
+EXIT_REACHED, EXIT_MAX_STEPS, EXIT_TOO_SMALL, EXIT_STIFF = 100, 101, 102, 103
+#: Stiffness test of Hairer's DOPRI5/DOP853 codes: h|λ| estimated after every accepted step; stiff
+#: after 15 consecutive estimates beyond the method's stability boundary on the negative real axis
+#: (3.25 DOPRI5, 6.1 DOP853), cleared after 6 below it (Hairer, Nørsett & Wanner I, Sec. IV.2).
+STIFF_BOUND = {"rk45": 3.25, "dop853": 6.1}
+STIFF_STEPS, NONSTIFF_STEPS = 15, 6
+STIFF_OFF, STIFF_WARN, STIFF_FAIL = 0, 1, 2
+DEFAULT_STIFFNESS = "warn"
 
 
 @_jit_inline
@@ -91,16 +98,21 @@ def _rms(e, y, y_new, rtol, atol):
 
 @_jit
 def advance(cd, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C, E, E3, E5, err_kind, err_exp,
-            rtol, atol, max_step, alpha, beta, projection, proj_tol, max_proj_iter,
-            K, y_new, y_old, f_old, tmp, lam, counters, out_info):
+            rtol, atol, max_step, alpha, beta, projection, proj_tol, max_proj_iter, stiff_bound, stiff_action,
+            K, y_new, y_old, f_old, tmp, y_st, lam, counters, out_info):
     r"""Take accepted steps from ``t`` until ``t_stop`` (or ``max_steps``); ``y``, ``f`` updated in place.
 
     ``need_f``: evaluate ``f = F(t, y)`` first (initial state, after a projection); with
     ``max_steps = 0`` that is all it does.  Every right-hand side of the loop goes through one
     call site, where :func:`_rhs` is inlined (one copy of the kernels to compile).
     ``y_old``/``f_old`` receive the state and derivative at the start of the last accepted step.
-    ``out_info = [t, h_abs, t_old, t_fail]``.  Returns an exit code: ``EXIT_REACHED``,
-    ``EXIT_MAX_STEPS`` or a failure (kernel status, ``EXIT_TOO_SMALL``).
+    ``out_info = [t, h_abs, t_old, t_fail, t_stiff, h|λ|]``.  Returns an exit code: ``EXIT_REACHED``,
+    ``EXIT_MAX_STEPS`` or a failure (kernel status, ``EXIT_TOO_SMALL``, ``EXIT_STIFF``).
+
+    Stiffness test (Hairer's codes): ``h|λ| ≈ h ‖f(ŷ) − f(y_s)‖ / ‖ŷ − y_s‖`` from the last internal
+    stage ``y_s`` (at ``c = 1``) and the new solution ``ŷ`` — a difference quotient of the Jacobian
+    along the error direction.  ``stiff_action``: 0 off, 1 record the first time in ``out_info[4]``,
+    2 also stop with ``EXIT_STIFF`` (as DOP853's ``IDID = −4``).
     """
     n = y.shape[0]
     ns = B.shape[0]
@@ -154,6 +166,9 @@ def advance(cd, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C,
                         for j in range(s):
                             acc += A[s, j] * K[j, i]
                         tmp[i] = y[i] + h * acc
+                    if s == ns - 1:
+                        for i in range(n):
+                            y_st[i] = tmp[i]
                     ts = t + C[s] * h
                 else:
                     for i in range(n):
@@ -207,7 +222,31 @@ def advance(cd, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C,
             h_abs *= fac if fac > MIN_FACTOR else MIN_FACTOR  # NaN error -> MIN_FACTOR
             rejected = True
             counters[C_REJ] += 1
-        # accepted
+        # accepted; stiffness test
+        if stiff_action != STIFF_OFF:
+            num = 0.0
+            den = 0.0
+            for i in range(n):
+                num += (K[ns, i] - K[ns - 1, i]) ** 2
+                den += (y_new[i] - y_st[i]) ** 2
+            if den > 0.0:
+                hl = abs(h) * np.sqrt(num / den)
+                if hl > stiff_bound:
+                    counters[C_NONSTI] = 0
+                    counters[C_IASTI] += 1
+                    if counters[C_IASTI] == STIFF_STEPS:
+                        counters[C_STIFF] += 1
+                        if not out_info[4] == out_info[4]:  # first detection (NaN before)
+                            out_info[4] = t_new
+                            out_info[5] = hl
+                        if stiff_action == STIFF_FAIL:
+                            out_info[0] = t
+                            out_info[3] = t_new
+                            return EXIT_STIFF
+                else:
+                    counters[C_NONSTI] += 1
+                    if counters[C_NONSTI] == NONSTIFF_STEPS:
+                        counters[C_IASTI] = 0
         for i in range(n):
             y_old[i] = y[i]
             f_old[i] = f[i]
@@ -257,10 +296,10 @@ class CompiledRK(Integrator):
     @classmethod
     def accepted_options(cls):
         if cls.stabilization == "baumgarte":
-            return ("alpha", "beta")
+            return ("alpha", "beta", "stiffness")
         if cls.stabilization == "projection":
-            return ("projection_tol", "max_projection_iter")
-        return ()
+            return ("projection_tol", "max_projection_iter", "stiffness")
+        return ("stiffness",)
 
     @classmethod
     def applicable(cls, system):
@@ -285,6 +324,14 @@ class CompiledRK(Integrator):
         self.max_projection_iter = int(o.get("max_projection_iter", 10))
         if not self.projection_tol > 0:
             raise ValueError(f"{self.name}: projection_tol must be > 0, got {self.projection_tol}")
+        actions = {"off": STIFF_OFF, "warn": STIFF_WARN, "fail": STIFF_FAIL}
+        stiffness = o.get("stiffness", DEFAULT_STIFFNESS)
+        if stiffness not in actions:
+            raise ValueError(f"{self.name}: stiffness must be one of {sorted(actions)}, got {stiffness!r}")
+        self._stiff_action = actions[stiffness]
+        self._stiff_bound = STIFF_BOUND["dop853" if self.scipy_solver is _si.DOP853 else "rk45"]
+        #: time [s] where the stiffness test first fired (None if it never did)
+        self.stiffness_detected_at: float | None = None
         s = self.scipy_solver
         self._A = np.ascontiguousarray(s.A, float)
         self._B = np.ascontiguousarray(s.B, float)
@@ -306,8 +353,10 @@ class CompiledRK(Integrator):
         self._f = np.zeros(n)
         self._y_new, self._y_old, self._f_old, self._tmp = (np.zeros(n) for _ in range(4))
         self._lam = np.zeros(max(system.n_c, 1))
-        self._cnt = np.zeros(4, np.int64)
-        self._info = np.zeros(4)
+        self._cnt = np.zeros(7, np.int64)
+        self._info = np.zeros(6)
+        self._info[4:] = np.nan
+        self._y_st = np.zeros(n)
         self._h_abs = 0.0
         if self.stabilization == "projection":
             nq = system.n_q
@@ -331,8 +380,9 @@ class CompiledRK(Integrator):
         return advance(self._cd, self._ws, t, y, f, need_f, t_stop, self.t_bound, self._h_abs, max_steps,
                        self._A, self._B, self._C, self._E, self._E3, self._E5, self._err_kind, self._err_exp,
                        self.rtol, self.atol, self.max_step, self.alpha, self.beta, self.stabilization == "projection",
-                       self.projection_tol, self.max_projection_iter, self._K, self._y_new, self._y_old,
-                       self._f_old, self._tmp, self._lam, self._cnt, self._info)
+                       self.projection_tol, self.max_projection_iter, self._stiff_bound, self._stiff_action,
+                       self._K, self._y_new, self._y_old, self._f_old, self._tmp, self._y_st, self._lam, self._cnt,
+                       self._info)
 
     def _evaluate(self, t, y, out):
         """``out = F(t, y)`` through the compiled loop's right-hand side; kernel status code."""
@@ -378,7 +428,7 @@ class CompiledRK(Integrator):
             return None
         steps0 = int(self._cnt[C_STEPS])
         info = self._info
-        info[:] = (self.t, self._h_abs, self.t, np.nan)
+        info[:4] = (self.t, self._h_abs, self.t, np.nan)
         code = self._advance_kernel(self.t, self._y, self._f, False, t_stop, max_steps)
         nq = self.system.n_q
         taken = int(self._cnt[C_STEPS]) - steps0
@@ -392,15 +442,26 @@ class CompiledRK(Integrator):
         self._h_abs = float(info[1])
         self.q, self.v = self._y[:nq].copy(), self._y[nq:].copy()
         self.a = self._f[nq:].copy()
+        if self.stiffness_detected_at is None and np.isfinite(info[4]):
+            self.stiffness_detected_at = float(info[4])
         if code in (EXIT_REACHED, EXIT_MAX_STEPS):
             if self.t >= self.t_bound - 1e-12 * max(1.0, abs(self.t_bound)):
                 self.t = self.t_bound
                 self.status = STATUS_FINISHED
                 self.message = "reached the end of the time span"
+                if self.stiffness_detected_at is not None:
+                    self.message += (f"; warning: the problem became stiff at t = {self.stiffness_detected_at:.6g} s "
+                                     f"(h|λ| ≈ {info[5]:.3g} beyond the stability boundary {self._stiff_bound} on "
+                                     f"{STIFF_STEPS} consecutive steps): the step size is limited by stability and "
+                                     "the stiff components are not error-controlled; check with an implicit method")
             return None
         if code == EXIT_TOO_SMALL:
             why = (f"step size fell below 10 ulp(t) at t = {info[3]:.6g} s (error test failing, e.g. non-finite "
                    "stages or a stiff problem beyond the explicit method's reach)")
+        elif code == EXIT_STIFF:
+            why = (f"the problem became stiff at t = {info[3]:.6g} s: h|λ| ≈ {info[5]:.3g} beyond the stability "
+                   f"boundary {self._stiff_bound} of the method on {STIFF_STEPS} consecutive steps (Hairer's "
+                   "stiffness test); use an implicit method (radau-ggl, generalized-alpha) or stiffness='warn'")
         elif code == _c.PROJECTION:
             why = (f"coordinate projection did not reach ‖Φ‖ ≤ {self.projection_tol:g} in "
                    f"{self.max_projection_iter} iterations at t = {info[3]:.6g} s")

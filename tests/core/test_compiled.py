@@ -302,3 +302,22 @@ def test_dependent_rows_give_a_non_positive_pivot():
     assert compiled.factor_schur(cd, ws) == compiled.OK
     ws.G[1] = ws.G[0]  # both rows of the ground pivot made equal: dependent rows
     assert compiled.factor_schur(cd, ws) == compiled.SINGULAR
+
+
+def test_stiffness_test_warns_or_stops():
+    """Hairer's stiffness test: on the k = 1e8 penalty chain the explicit step is stability-limited
+    (h|λ| beyond the boundary on 15 consecutive steps); the rigid chain never trips it."""
+    stiff = models.n_link_chain(2, planar=True, stiff_k=1e8)
+    kw = dict(t_eval=[0.02], rtol=1e-5, atol=1e-5, compute_multipliers=False)
+    warn = simulate(stiff, (0.0, 0.02), "jit-dop853", **kw)
+    assert warn.status == "finished" and "became stiff at t =" in warn.message
+    stop = simulate(stiff, (0.0, 0.02), "jit-dop853", stiffness="fail", **kw)
+    assert stop.status == "failed" and "use an implicit method" in stop.message
+    assert stop.t[-1] < 0.02 and np.all(np.isfinite(stop.q))  # what was computed is kept
+    off = simulate(stiff, (0.0, 0.02), "jit-dop853", stiffness="off", **kw)
+    assert off.status == "finished" and "stiff" not in off.message
+    np.testing.assert_array_equal(off.q[-1], warn.q[-1])  # the test only observes
+    rigid = simulate(models.n_link_chain(8, planar=True), (0.0, 1.0), "jit-rk45", **{**kw, "t_eval": [1.0]})
+    assert rigid.status == "finished" and "stiff" not in rigid.message
+    with pytest.raises(ValueError, match="stiffness must be one of"):
+        simulate(stiff, (0.0, 0.02), "jit-rk45", stiffness="maybe")

@@ -844,8 +844,10 @@ def project(cd, ws, q, v, tol, max_iter, counters):
             _subtract_X_mu(ws.X, cd.r_b, cd.act, cd.perm_of_row, cd.nb, cd.nvb, rhs, zero_v)  # Δ = −M⁻¹ Φ_qᵀ S⁻¹ Φ
             retract(cd, q, zero_v)
             n_iter += 1
-            # Φ at the new positions, Φ_q (and its factor) frozen: evaluate into phi only
-            _phi_only(cd, ws, q)
+            # Φ at the new positions; the factor L and M⁻¹Φ_qᵀ blocks X stay frozen (constraint_terms
+            # rewrites only Φ, the G blocks and γ; G is not used until the velocity stage re-evaluates it)
+            _body_states_ool(cd, q, v, ws)
+            _constraint_terms_ool(cd, ws, True, False)
             err = _max_abs_phi(cd, ws)
             if err <= tol:
                 break
@@ -866,13 +868,6 @@ def project(cd, ws, q, v, tol, max_iter, counters):
     _solve_schur_ool(cd, ws, rhs)
     _subtract_X_mu(ws.X, cd.r_b, cd.act, cd.perm_of_row, cd.nb, cd.nvb, rhs, v)
     return n_iter
-
-
-@_jit
-def _phi_only(cd, ws, q):
-    """``Φ(q)`` into ``ws.phi`` keeping ``ws.G`` (the frozen Jacobian of the projection)."""
-    _positions_only(cd, q, ws)
-    _constraint_phi(cd, ws)
 
 
 @_jit_inline
@@ -902,49 +897,6 @@ def _positions_only(cd, q, ws):
             ws.A[b, 2, 0] = 2.0 * (e1 * e3 - e0 * e2)
             ws.A[b, 2, 1] = 2.0 * (e2 * e3 + e0 * e1)
             ws.A[b, 2, 2] = 2.0 * (e0 * e0 + e3 * e3) - 1.0
-
-
-@_jit
-def _constraint_phi(cd, ws):
-    """Φ rows only (no Jacobian) from the current ``ws.r, ws.A``."""
-    dim = cd.dim
-    A, r, phi = ws.A, ws.r, ws.phi
-    V1, V2, V3 = cd.c_v1, cd.c_v2, cd.c_v3
-    for e in range(cd.c_kind.shape[0]):
-        kind = cd.c_kind[e]
-        bi, bj, r0 = cd.c_bi[e], cd.c_bj[e], cd.c_row0[e]
-        p0, p1, p2 = V1[e, 0], V1[e, 1], V1[e, 2]
-        q0, q1, q2 = V2[e, 0], V2[e, 1], V2[e, 2]
-        if kind == K_POINT:
-            a0, a1, a2 = _Av(A, bi, p0, p1, p2)
-            b0, b1, b2 = _Av(A, bj, q0, q1, q2)
-            phi[r0] = r[bi, 0] + a0 - r[bj, 0] - b0
-            phi[r0 + 1] = r[bi, 1] + a1 - r[bj, 1] - b1
-            if dim == 3:
-                phi[r0 + 2] = r[bi, 2] + a2 - r[bj, 2] - b2
-        elif kind == K_DOT1:
-            a0, a1, a2 = _Av(A, bi, p0, p1, p2)
-            b0, b1, b2 = _Av(A, bj, q0, q1, q2)
-            phi[r0] = a0 * b0 + a1 * b1 + a2 * b2 - cd.c_scalar[e]
-        elif kind == K_DOT2:
-            a0, a1, a2 = _Av(A, bi, p0, p1, p2)
-            u0, u1, u2 = _Av(A, bi, q0, q1, q2)
-            v0, v1, v2 = _Av(A, bj, V3[e, 0], V3[e, 1], V3[e, 2])
-            phi[r0] = (a0 * (r[bj, 0] + v0 - r[bi, 0] - u0) + a1 * (r[bj, 1] + v1 - r[bi, 1] - u1)
-                       + a2 * (r[bj, 2] + v2 - r[bi, 2] - u2) - cd.c_scalar[e])
-        elif kind == K_DIST:
-            L = cd.c_scalar[e]
-            u0, u1, u2 = _Av(A, bi, p0, p1, p2)
-            v0, v1, v2 = _Av(A, bj, q0, q1, q2)
-            d0 = r[bj, 0] + v0 - r[bi, 0] - u0
-            d1 = r[bj, 1] + v1 - r[bi, 1] - u1
-            d2 = r[bj, 2] + v2 - r[bi, 2] - u2
-            phi[r0] = (d0 * d0 + d1 * d1 + d2 * d2 - L * L) / (2.0 * L)
-        else:
-            ti = np.arctan2(A[bi, 1, 0], A[bi, 0, 0])
-            tj = np.arctan2(A[bj, 1, 0], A[bj, 0, 0])
-            x = tj - ti - cd.c_scalar[e]
-            phi[r0] = np.arctan2(np.sin(x), np.cos(x))
 
 
 # Out-of-line twins of the inlined kernels for the projection: it runs once per step, so a call

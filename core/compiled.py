@@ -406,6 +406,22 @@ def _uC(A, b, s0, s1, s2, u0, u1, u2):
 
 
 @_jit_inline
+def _rel_point(r, A, bi, p0, p1, p2, bj, q0, q1, q2):
+    """``d = r_Q − r_P`` with P = s̄_p on body i, Q = s̄_q on body j."""
+    u0, u1, u2 = _Av(A, bi, p0, p1, p2)
+    v0, v1, v2 = _Av(A, bj, q0, q1, q2)
+    return r[bj, 0] + v0 - r[bi, 0] - u0, r[bj, 1] + v1 - r[bi, 1] - u1, r[bj, 2] + v2 - r[bi, 2] - u2
+
+
+@_jit_inline
+def _rel_vel(rd, A, w, bi, p0, p1, p2, bj, q0, q1, q2):
+    """``ḋ = ṙ_Q − ṙ_P`` (velocities of the same two body-fixed points)."""
+    x0, x1, x2 = _vel(A, w, bi, p0, p1, p2)
+    y0, y1, y2 = _vel(A, w, bj, q0, q1, q2)
+    return rd[bj, 0] + y0 - rd[bi, 0] - x0, rd[bj, 1] + y1 - rd[bi, 1] - x1, rd[bj, 2] + y2 - rd[bi, 2] - x2
+
+
+@_jit_inline
 def _put(G, row, sl, dim, t0, t1, t2, c0, c1, c2):
     """Store a Jacobian row block (translation t, rotation c) in the model's velocity layout."""
     if dim == 2:
@@ -477,11 +493,7 @@ def constraint_terms(cd, ws, want_phi, want_gamma):
             # p = ā_i, q = s̄_i (P on i), v3 = s̄_j (Q on j); d = r_Q − r_P
             s0, s1, s2 = V3[e, 0], V3[e, 1], V3[e, 2]
             a0, a1, a2 = _Av(A, bi, p0, p1, p2)
-            u0, u1, u2 = _Av(A, bi, q0, q1, q2)
-            v0, v1, v2 = _Av(A, bj, s0, s1, s2)
-            d0 = r[bj, 0] + v0 - r[bi, 0] - u0
-            d1 = r[bj, 1] + v1 - r[bi, 1] - u1
-            d2 = r[bj, 2] + v2 - r[bi, 2] - u2
+            d0, d1, d2 = _rel_point(r, A, bi, q0, q1, q2, bj, s0, s1, s2)
             if want_phi:
                 phi[r0] = a0 * d0 + a1 * d1 + a2 * d2 - cd.c_scalar[e]
             x0, x1, x2 = _uC(A, bi, p0, p1, p2, d0, d1, d2)
@@ -491,11 +503,7 @@ def constraint_terms(cd, ws, want_phi, want_gamma):
             _put(G, r0, 1, dim, a0, a1, a2, z0, z1, z2)
             if want_gamma:
                 ad0, ad1, ad2 = _vel(A, w, bi, p0, p1, p2)  # ȧ_i
-                x0, x1, x2 = _vel(A, w, bi, q0, q1, q2)
-                y0, y1, y2 = _vel(A, w, bj, s0, s1, s2)
-                dd0 = rd[bj, 0] + y0 - rd[bi, 0] - x0
-                dd1 = rd[bj, 1] + y1 - rd[bi, 1] - x1
-                dd2 = rd[bj, 2] + y2 - rd[bi, 2] - x2
+                dd0, dd1, dd2 = _rel_vel(rd, A, w, bi, q0, q1, q2, bj, s0, s1, s2)
                 g0, g1, g2 = _aq(A, w, bi, p0, p1, p2)
                 h0, h1, h2 = _aq(A, w, bj, s0, s1, s2)
                 k0, k1, k2 = _aq(A, w, bi, q0, q1, q2)
@@ -504,11 +512,7 @@ def constraint_terms(cd, ws, want_phi, want_gamma):
         elif kind == K_DIST:
             # p = s̄_i, q = s̄_j
             L = cd.c_scalar[e]
-            u0, u1, u2 = _Av(A, bi, p0, p1, p2)
-            v0, v1, v2 = _Av(A, bj, q0, q1, q2)
-            d0 = r[bj, 0] + v0 - r[bi, 0] - u0
-            d1 = r[bj, 1] + v1 - r[bi, 1] - u1
-            d2 = r[bj, 2] + v2 - r[bi, 2] - u2
+            d0, d1, d2 = _rel_point(r, A, bi, p0, p1, p2, bj, q0, q1, q2)
             if want_phi:
                 phi[r0] = (d0 * d0 + d1 * d1 + d2 * d2 - L * L) / (2.0 * L)
             e0, e1, e2 = d0 / L, d1 / L, d2 / L
@@ -517,11 +521,7 @@ def constraint_terms(cd, ws, want_phi, want_gamma):
             _put(G, r0, 0, dim, -e0, -e1, -e2, -x0, -x1, -x2)
             _put(G, r0, 1, dim, e0, e1, e2, y0, y1, y2)
             if want_gamma:
-                x0, x1, x2 = _vel(A, w, bi, p0, p1, p2)
-                y0, y1, y2 = _vel(A, w, bj, q0, q1, q2)
-                dd0 = rd[bj, 0] + y0 - rd[bi, 0] - x0
-                dd1 = rd[bj, 1] + y1 - rd[bi, 1] - x1
-                dd2 = rd[bj, 2] + y2 - rd[bi, 2] - x2
+                dd0, dd1, dd2 = _rel_vel(rd, A, w, bi, p0, p1, p2, bj, q0, q1, q2)
                 g0, g1, g2 = _aq(A, w, bj, q0, q1, q2)
                 h0, h1, h2 = _aq(A, w, bi, p0, p1, p2)
                 gam[r0] = -(dd0 * dd0 + dd1 * dd1 + dd2 * dd2
@@ -585,16 +585,8 @@ def applied_forces(cd, ws, Q):
             bi, bj = BI[e], BJ[e]
             p0, p1, p2 = SI[e, 0], SI[e, 1], SI[e, 2]
             q0, q1, q2 = SJ[e, 0], SJ[e, 1], SJ[e, 2]
-            u0, u1, u2 = _Av(A, bi, p0, p1, p2)
-            v0, v1, v2 = _Av(A, bj, q0, q1, q2)
-            x0, x1, x2 = _vel(A, w, bi, p0, p1, p2)
-            y0, y1, y2 = _vel(A, w, bj, q0, q1, q2)
-            d0 = r[bj, 0] + v0 - r[bi, 0] - u0
-            d1 = r[bj, 1] + v1 - r[bi, 1] - u1
-            d2 = r[bj, 2] + v2 - r[bi, 2] - u2
-            dd0 = rd[bj, 0] + y0 - rd[bi, 0] - x0
-            dd1 = rd[bj, 1] + y1 - rd[bi, 1] - x1
-            dd2 = rd[bj, 2] + y2 - rd[bi, 2] - x2
+            d0, d1, d2 = _rel_point(r, A, bi, p0, p1, p2, bj, q0, q1, q2)
+            dd0, dd1, dd2 = _rel_vel(rd, A, w, bi, p0, p1, p2, bj, q0, q1, q2)
             if kind == 0:  # zero-length point spring: F_P = k d + c ḋ
                 F0 = K[e] * d0 + C[e] * dd0
                 F1 = K[e] * d1 + C[e] * dd1

@@ -28,7 +28,7 @@ _EXPORTS: dict[str, str] = {
     "ModelBuilder": "model",
     "Model": "model",
     "ConstrainedSystem": "system",
-    "simulate": "integrators",
+    "simulate": "simulation",
     "SimulationResult": "results",
     "write_table": "results",
 }

@@ -8,20 +8,8 @@ names.
 
 Equations
 ---------
-*Assembly* (kinematic analysis at one instant, Haug 1989, Sec. 3.5; Nikravesh 1988, Sec. 3.4).
-Gauss–Newton with minimum-norm increments in velocity space, applied with the retraction,
-
-.. math::
-
-    \Delta v_k = -\Phi_q(t, q_k)^{+}\, \Phi(t, q_k), \qquad q_{k+1} = q_k \oplus \alpha_k \Delta v_k,
-
-(``⁺`` the Moore–Penrose pseudo-inverse, so redundant rows are harmless; ``α_k`` halves until
-``‖Φ‖₂`` decreases), then the velocity correction of least kinetic-energy norm
-
-.. math::
-
-    \min_{\Delta v} \tfrac12 \Delta v^T M \Delta v \quad\text{s.t.}\quad
-    \Phi_q (v_0 + \Delta v) = \nu .
+*Assembly* (kinematic analysis at one instant): :mod:`core.assembly` (``assemble_state`` and
+``assemble`` are re-exported here).
 
 *Kinematic analysis* of a fully driven mechanism (``n_v = rank Φ_q``): at each time
 ``Φ(t, q) = 0``, ``Φ_q v = ν``, ``Φ_q a = γ(t, q, v)`` (Haug 1989, Eqs. 3.5.1–3.5.3).
@@ -76,11 +64,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 import scipy.linalg as sla
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from .dynamics import accelerations
+from .assembly import assemble, assemble_state, coordinate_scale, newton_positions, truncated_svd
+from .dynamics import accelerations, minimum_norm_correction, minimum_norm_multipliers
+from .errors import AssemblyError, InputError
 from .system import ConstrainedSystem, as_dense
 
 Array = NDArray[np.float64]
@@ -111,73 +99,6 @@ class AnalysisWarning(UserWarning):
 # ------------------------------------------------------------------------------------------------
 
 
-def _assembly_error():
-    from .model import AssemblyError
-
-    return AssemblyError
-
-
-def _min_norm(J, r: Array, W=None) -> Array:
-    """``argmin ½ xᵀWx`` subject to ``J x = r`` (least squares in ``J x ≈ r`` if inconsistent).
-
-    ``W = None`` is the identity.  Sparse KKT factorisation first; dense minimum-norm least squares
-    (``gelsd``) when ``J`` is rank deficient and the linearised system inconsistent.
-    """
-    n_c, n_v = J.shape
-    if n_c == 0:
-        return np.zeros(n_v)
-    Ws = sp.identity(n_v, format="csc") if W is None else sp.csc_matrix(W)
-    K = sp.bmat([[Ws, sp.csr_matrix(J).T], [sp.csr_matrix(J), None]], format="csc")
-    rhs = np.concatenate([np.zeros(n_v), r])
-    try:
-        with np.errstate(all="raise"), warnings.catch_warnings():
-            warnings.simplefilter("error", spla.MatrixRankWarning)
-            sol = spla.splu(K).solve(rhs)
-        if np.all(np.isfinite(sol)) and np.linalg.norm(K @ sol - rhs) <= 1e-10 * (1.0 + np.linalg.norm(rhs)):
-            return sol[:n_v]
-    except (RuntimeError, FloatingPointError, ValueError, spla.MatrixRankWarning):
-        pass
-    Jd = as_dense(J)
-    if W is None:
-        return sla.lstsq(Jd, r, lapack_driver="gelsd")[0]
-    try:
-        L = np.linalg.cholesky(as_dense(W))
-    except np.linalg.LinAlgError:
-        return sla.lstsq(Jd, r, lapack_driver="gelsd")[0]
-    # x = L⁻ᵀ y, min ‖y‖ s.t. (J L⁻ᵀ) y = r
-    B = sla.solve_triangular(L, Jd.T, lower=True).T
-    y = sla.lstsq(B, r, lapack_driver="gelsd")[0]
-    return sla.solve_triangular(L.T, y, lower=False)
-
-
-def _truncated_svd(J, rank_tol: float = 1e-6, max_rank: int | None = None):
-    """``(U_r, s_r, V_r, N)`` of dense ``J`` keeping singular values ``> rank_tol·s_max`` (and at most
-    ``max_rank``); ``N`` spans the remaining right singular directions (the numerical null space).
-
-    Newton iterations use the truncated pseudo-inverse: near a configuration where rows are
-    redundant, the "redundant" singular value is only O(‖Φ‖) and keeping it makes Newton converge
-    linearly towards the singular root (ratio ½); truncating it restores quadratic convergence.
-    """
-    Jd = as_dense(J)
-    n_v = Jd.shape[1]
-    if Jd.shape[0] == 0:
-        return np.zeros((0, 0)), np.zeros(0), np.zeros((n_v, 0)), np.eye(n_v)
-    U, s, Vt = np.linalg.svd(Jd, full_matrices=True)
-    r = int(np.sum(s > rank_tol * s[0])) if len(s) and s[0] > 0 else 0
-    if max_rank is not None:
-        r = min(r, max_rank)
-    return U[:, :r], s[:r], Vt[:r].T, Vt[r:].T
-
-
-def _lstsq_multipliers(J, rhs: Array) -> tuple[Array, float]:
-    """Minimum-norm ``λ`` of ``Jᵀλ ≈ rhs`` and the residual 2-norm."""
-    Jd = as_dense(J)
-    if Jd.shape[0] == 0:
-        return np.zeros(0), float(np.linalg.norm(rhs))
-    lam = sla.lstsq(Jd.T, rhs, lapack_driver="gelsd")[0]
-    return lam, float(np.linalg.norm(Jd.T @ lam - rhs))
-
-
 def _rank(J, tol: float = 1e-9) -> int:
     Jd = as_dense(J)
     if Jd.size == 0:
@@ -200,10 +121,6 @@ def null_space_basis(J, tol: float = 1e-9) -> Array:
     return Vt[rank:].T.copy()
 
 
-def _scale(q: Array) -> float:
-    return max(1.0, float(np.max(np.abs(q)))) if len(q) else 1.0
-
-
 def _q_jacobians(system: ConstrainedSystem, t: float, q: Array, v: Array) -> tuple[Array, Array]:
     Qq, Qv = system.Q_jacobians(t, q, v)
     return as_dense(Qq), as_dense(Qv)
@@ -218,7 +135,7 @@ def _geometric_stiffness(system: ConstrainedSystem, t: float, q: Array, lam: Arr
     G = np.zeros((n_v, n_v))
     if system.n_c == 0 or not np.any(lam):
         return G
-    h = 1e-6 * _scale(q) if h is None else h
+    h = 1e-6 * coordinate_scale(q) if h is None else h
     for k in range(n_v):
         dv = np.zeros(n_v)
         dv[k] = h
@@ -233,7 +150,7 @@ def _mass_gradient(system: ConstrainedSystem, t: float, q: Array, a: Array, h: f
     n_v = system.n_v
     if getattr(system, "mass_is_constant", False) or not np.any(a):
         return np.zeros((n_v, n_v))
-    h = 1e-6 * _scale(q) if h is None else h
+    h = 1e-6 * coordinate_scale(q) if h is None else h
     G = np.zeros((n_v, n_v))
     for k in range(n_v):
         dv = np.zeros(n_v)
@@ -264,119 +181,6 @@ def _names(system: ConstrainedSystem) -> tuple[list[str], list[str], list[str]]:
 # ------------------------------------------------------------------------------------------------
 # 1. assembly
 # ------------------------------------------------------------------------------------------------
-
-
-def _newton_positions(system, t, q, tol, max_iter):
-    """Gauss–Newton on Φ(t, q) = 0; returns (q, converged, iterations, phi)."""
-    q = system.normalize(np.asarray(q, float).copy())
-    scale = _scale(q)
-    phi = np.asarray(system.Phi(t, q), float)
-    if not np.all(np.isfinite(phi)):
-        return q, False, 0, phi
-    it = 0
-    for it in range(1, max_iter + 1):
-        if np.max(np.abs(phi), initial=0.0) <= tol * scale:
-            return q, True, it - 1, phi
-        U, sv, V, _ = _truncated_svd(system.Phi_q(t, q))
-        dv = -V @ ((U.T @ phi) / sv)
-        f0 = float(phi @ phi)
-        alpha = 1.0
-        while True:
-            q_new = system.retract(q, alpha * dv)
-            phi_new = np.asarray(system.Phi(t, q_new), float)
-            f1 = float(phi_new @ phi_new) if np.all(np.isfinite(phi_new)) else np.inf
-            if f1 <= (1.0 - 1e-4 * alpha) * f0 or alpha < 1.0 / 64:
-                break
-            alpha *= 0.5
-        if not np.isfinite(f1):
-            return q, False, it, phi
-        if alpha < 1.0 / 64 and f1 >= f0:  # stalled at a stationary point of ‖Φ‖²
-            return q_new, False, it, phi_new
-        q, phi = q_new, phi_new
-    return q, bool(np.max(np.abs(phi), initial=0.0) <= tol * scale), it, phi
-
-
-def _project_velocities(system, t, q, v, weighting: str):
-    J = system.Phi_q(t, q)
-    if J.shape[0] == 0:
-        return np.asarray(v, float).copy()
-    r = np.asarray(system.nu(t, q), float) - np.asarray(J @ v).ravel()
-    W = None if weighting == "identity" else system.M(t, q)
-    return np.asarray(v, float) + _min_norm(J, r, W)
-
-
-def assemble_state(system: ConstrainedSystem, q_guess: ArrayLike | None = None, v_guess: ArrayLike | None = None,
-                   t: float = 0.0, tol: float = 1e-10, max_iter: int = 50,
-                   velocity_weighting: str = "mass") -> tuple[Array, Array]:
-    r"""Consistent positions and velocities near a guess (kinematic assembly).
-
-    Positions: Gauss–Newton ``Δv = −Φ_q⁺ Φ`` (minimum-norm increments in velocity space, applied with
-    ``system.retract``; backtracking on ``‖Φ‖₂``).  Velocities: the correction of least norm
-    ``½ΔvᵀWΔv`` with ``Φ_q(v + Δv) = ν``, ``W = M`` (kinetic-energy norm, default) or ``W = I``.
-    Redundant rows are handled by the pseudo-inverse.
-
-    Parameters
-    ----------
-    system : ConstrainedSystem
-    q_guess : array_like, shape (n_q,), optional
-        Rough configuration; default ``system.q0``.
-    v_guess : array_like, shape (n_v,), optional
-        Default ``system.v0``.
-    t : float
-        Time [s] (driving constraints).
-    tol : float
-        Convergence when ``max|Φ| ≤ tol·max(1, max|q|)`` [m or rad].
-    max_iter : int
-    velocity_weighting : {'mass', 'identity'}
-
-    Returns
-    -------
-    q : ndarray, shape (n_q,)
-    v : ndarray, shape (n_v,)
-
-    Raises
-    ------
-    core.model.AssemblyError
-        Newton did not converge; the message names the worst violated constraint.
-    """
-    if velocity_weighting not in ("mass", "identity"):
-        raise ValueError(f"velocity_weighting must be 'mass' or 'identity', got {velocity_weighting!r}")
-    q0 = np.asarray(system.q0 if q_guess is None else q_guess, float)
-    v0 = np.asarray(system.v0 if v_guess is None else v_guess, float)
-    if q0.shape != (system.n_q,):
-        raise ValueError(f"{system.name}: q_guess has shape {q0.shape}, expected ({system.n_q},)")
-    if v0.shape != (system.n_v,):
-        raise ValueError(f"{system.name}: v_guess has shape {v0.shape}, expected ({system.n_v},)")
-    if system.n_c == 0:
-        return system.normalize(q0.copy()), v0.copy()
-    q, ok, it, phi = _newton_positions(system, t, q0, tol, max_iter)
-    if not ok:
-        names = list(getattr(system, "constraint_names", []) or [f"Phi[{i}]" for i in range(system.n_c)])
-        if np.all(np.isfinite(phi)):
-            k = int(np.argmax(np.abs(phi)))
-            what = f"constraint {names[k]!r} is still violated by {phi[k]:.3e}"
-        else:
-            k = int(np.flatnonzero(~np.isfinite(phi))[0])
-            what = f"constraint {names[k]!r} is not finite"
-        raise _assembly_error()(
-            f"{system.name}: assembly at t = {t:g} s did not converge after {it} Newton iterations; {what} "
-            f"(tolerance {tol:g}). Improve the initial guess or check the joint definitions."
-        )
-    v = _project_velocities(system, t, q, v0, velocity_weighting)
-    return q, v
-
-
-def assemble(model, q_guess: ArrayLike | None = None, v_guess: ArrayLike | None = None, t: float = 0.0,
-             tol: float = 1e-10, max_iter: int = 50, velocity_weighting: str = "mass"):
-    """Return ``model.with_state(q, v)`` with ``(q, v)`` from :func:`assemble_state`.
-
-    Used by ``ModelBuilder.build(assemble=True)``.  For systems without ``with_state`` call
-    :func:`assemble_state`, which returns the arrays.
-    """
-    if not hasattr(model, "with_state"):
-        raise TypeError(f"{type(model).__name__} has no with_state(); use assemble_state(system, ...) -> (q, v)")
-    q, v = assemble_state(model, q_guess, v_guess, t=t, tol=tol, max_iter=max_iter, velocity_weighting=velocity_weighting)
-    return model.with_state(q, v)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -419,7 +223,7 @@ def kinematic_analysis(system: ConstrainedSystem, times: ArrayLike, q_guess: Arr
     """
     times = np.asarray(times, float).ravel()
     if len(times) == 0 or np.any(np.diff(times) <= 0):
-        raise ValueError("kinematic_analysis: times must be a non-empty, strictly increasing array")
+        raise InputError("kinematic_analysis: times must be a non-empty, strictly increasing array")
     qn, vn, an = _names(system)
     q = np.asarray(system.q0 if q_guess is None else q_guess, float)
     rows: list[np.ndarray] = []
@@ -432,18 +236,18 @@ def kinematic_analysis(system: ConstrainedSystem, times: ArrayLike, q_guess: Arr
         try:
             q, v = assemble_state(system, q, np.zeros(system.n_v), t=t, tol=tol, max_iter=max_iter,
                                   velocity_weighting="identity")
-        except ValueError as exc:  # AssemblyError is a ValueError
+        except AssemblyError as exc:
             status, message = "failed", f"kinematic analysis stopped at t = {t:g} s: {exc}"
             break
         J = system.Phi_q(t, q)
         if i == 0:
             dof = system.n_v - _rank(J)
             if dof != 0:
-                raise ValueError(
+                raise InputError(
                     f"{system.name}: kinematic_analysis needs a fully driven system, but {dof} degree(s) of "
                     f"freedom remain (n_v = {system.n_v}, rank Φ_q = {system.n_v - dof}); add drivers"
                 )
-        a = _min_norm(J, np.asarray(system.gamma(t, q, v), float))
+        a = minimum_norm_correction(J, np.asarray(system.gamma(t, q, v), float))
         rows.append(np.concatenate([[t], q, v, a]))
     df = pd.DataFrame(np.array(rows).reshape(len(rows), 1 + system.n_q + 2 * system.n_v),
                       columns=["t [s]", *qn, *vn, *an])
@@ -520,7 +324,7 @@ class StaticEquilibrium:
 def _energy_step(system, t, q, r1, J, lam, rank0, tol):
     """One projected, energy-descending reduced Newton step of :func:`static_equilibrium`."""
     zero = np.zeros(system.n_v)
-    _, _, _, N = _truncated_svd(J, max_rank=rank0)
+    _, _, _, N = truncated_svd(J, max_rank=rank0)
     Qq, _ = _q_jacobians(system, t, q, zero)
     KN = N.T @ (-Qq + _geometric_stiffness(system, t, q, lam)) @ N
     g = N.T @ r1  # reduced generalized force = −(reduced gradient of the potential)
@@ -533,7 +337,7 @@ def _energy_step(system, t, q, r1, J, lam, rank0, tol):
     alpha = 1.0
     while alpha >= 1.0 / 1024:
         try:
-            q1, ok, _, _ = _newton_positions(system, t, system.retract(q, alpha * (N @ z)), tol, 50)
+            q1, ok, _, _ = newton_positions(system, t, system.retract(q, alpha * (N @ z)), tol, 50)
         except (ValueError, FloatingPointError, np.linalg.LinAlgError):
             ok = False
         if ok:
@@ -543,7 +347,7 @@ def _energy_step(system, t, q, r1, J, lam, rank0, tol):
             if pd_ and alpha == 1.0:  # near the minimum energy differences drown in round-off
                 J1 = system.Phi_q(t, q1)
                 Q1 = np.asarray(system.Q(t, q1, zero), float)
-                lam1, _ = _lstsq_multipliers(J1, Q1)
+                lam1, _ = minimum_norm_multipliers(J1, Q1)
                 if np.linalg.norm(Q1 - np.asarray(J1.T @ lam1).ravel()) < 0.5 * n0:
                     return q1
         alpha *= 0.5
@@ -601,20 +405,20 @@ def static_equilibrium(system: ConstrainedSystem, q_guess: ArrayLike | None = No
     zero = np.zeros(n_v)
     q, _ = assemble_state(system, q_guess, zero, t=t, tol=tol)
     fscale = max(1.0, float(np.max(np.abs(system.Q(t, q, zero)), initial=0.0)))
-    qscale = _scale(q)
+    qscale = coordinate_scale(q)
 
     def residual(q):
         # λ eliminated by least squares: λ(q) = (Φ_qᵀ)⁺ Q, so r1 = Q − Φ_qᵀλ is the part of Q that the
         # constraints cannot balance; the minimum-norm choice keeps λ unique with redundant rows.
         J = system.Phi_q(t, q)
         Q = np.asarray(system.Q(t, q, zero), float)
-        lam, _ = _lstsq_multipliers(J, Q)
+        lam, _ = minimum_norm_multipliers(J, Q)
         r1 = Q - np.asarray(J.T @ lam).ravel() if system.n_c else Q
         r2 = np.asarray(system.Phi(t, q), float)
         return r1, r2, J, lam
 
     if method not in ("auto", "energy", "newton"):
-        raise ValueError(f"static_equilibrium: method must be 'auto', 'energy' or 'newton', got {method!r}")
+        raise InputError(f"static_equilibrium: method must be 'auto', 'energy' or 'newton', got {method!r}")
     if method == "auto":
         method = "energy" if (getattr(system, "is_conservative", False)
                               and system.energy(t, q, zero) is not None) else "newton"
@@ -637,7 +441,7 @@ def static_equilibrium(system: ConstrainedSystem, q_guess: ArrayLike | None = No
         Qq, _ = _q_jacobians(system, t, q, zero)
         KT = -Qq + _geometric_stiffness(system, t, q, lam)
         # null-space Newton step: Φ_q Δv = −Φ on the numerical range, Nᵀ(K_T Δv − r1) = 0
-        U, sv, Y, N = _truncated_svd(J, max_rank=rank0)
+        U, sv, Y, N = truncated_svd(J, max_rank=rank0)
         dy = Y @ (-(U.T @ r2) / sv) if len(sv) else np.zeros(n_v)
         KN = N.T @ KT @ N
         rhs = N.T @ (r1 - KT @ dy)
@@ -666,7 +470,7 @@ def static_equilibrium(system: ConstrainedSystem, q_guess: ArrayLike | None = No
             f"max|Q − Φ_qᵀλ| = {np.max(np.abs(r1), initial=0):.3e} (worst along {qn[k]!r}), "
             f"max|Φ| = {np.max(np.abs(r2), initial=0):.3e}"
         )
-    lam, _ = _lstsq_multipliers(J, np.asarray(system.Q(t, q, zero), float))  # minimum-norm set
+    lam, _ = minimum_norm_multipliers(J, np.asarray(system.Q(t, q, zero), float))  # minimum-norm set
     r1 = np.asarray(system.Q(t, q, zero), float) - np.asarray(J.T @ lam).ravel() if system.n_c else np.asarray(system.Q(t, q, zero), float)
     N = null_space_basis(J)
     Qq, _ = _q_jacobians(system, t, q, zero)
@@ -712,7 +516,7 @@ def _driver_rows(system: ConstrainedSystem, drivers) -> dict[str, tuple[NDArray[
         elif d in names:
             out[d] = (np.array([names.index(d)]), "-")
         else:
-            raise ValueError(f"{system.name}: unknown driver {d!r} (neither a reaction group nor a constraint name)")
+            raise InputError(f"{system.name}: unknown driver {d!r} (neither a reaction group nor a constraint name)")
     return out
 
 
@@ -756,7 +560,7 @@ def inverse_dynamics(system: ConstrainedSystem, t: ArrayLike, q: ArrayLike, v: A
     n_t = len(t)
     for nm, arr, n in (("q", q, system.n_q), ("v", v, system.n_v), ("a", a, system.n_v)):
         if arr.shape != (n_t, n):
-            raise ValueError(f"inverse_dynamics: {nm} has shape {arr.shape}, expected ({n_t}, {n})")
+            raise InputError(f"inverse_dynamics: {nm} has shape {arr.shape}, expected ({n_t}, {n})")
     cnames = list(getattr(system, "constraint_names", []) or [f"Phi[{i}]" for i in range(system.n_c)])
     drv = _driver_rows(system, drivers)
     rnames = system.reaction_names()
@@ -767,7 +571,7 @@ def inverse_dynamics(system: ConstrainedSystem, t: ArrayLike, q: ArrayLike, v: A
         M = system.M(t[i], q[i])
         rhs = np.asarray(system.Q(t[i], q[i], v[i]), float) - np.asarray(M @ a[i]).ravel()
         J = system.Phi_q(t[i], q[i])
-        L[i], res[i] = _lstsq_multipliers(J, rhs)
+        L[i], res[i] = minimum_norm_multipliers(J, rhs)
         for name, val in system.reactions(t[i], q[i], L[i]).items():
             reac.setdefault(name, []).append(np.asarray(val, float))
     cols: dict[str, Array] = {"t [s]": t}
@@ -808,12 +612,12 @@ def inverse_dynamics_from_result(system: ConstrainedSystem, result, method: str 
     v = np.asarray(result.v, float)
     if method == "differentiate":
         if len(t) < 4:
-            raise ValueError("inverse_dynamics_from_result: 'differentiate' needs at least 4 samples")
+            raise InputError("inverse_dynamics_from_result: 'differentiate' needs at least 4 samples")
         a = CubicSpline(t, v, axis=0)(t, 1)
     elif method == "forward":
         a = np.array([accelerations(system, ti, qi, vi)[0] for ti, qi, vi in zip(t, q, v)])
     else:
-        raise ValueError(f"inverse_dynamics_from_result: method must be 'differentiate' or 'forward', got {method!r}")
+        raise InputError(f"inverse_dynamics_from_result: method must be 'differentiate' or 'forward', got {method!r}")
     return inverse_dynamics(system, t, q, v, a, drivers=drivers)
 
 
@@ -899,10 +703,10 @@ def linearize(system: ConstrainedSystem, q: ArrayLike | None = None, v: ArrayLik
     v = np.zeros(system.n_v) if v is None else np.asarray(v, float)
     if system.n_c:
         phi = np.asarray(system.Phi(t, q))
-        if np.max(np.abs(phi)) > 1e-6 * _scale(q):
+        if np.max(np.abs(phi)) > 1e-6 * coordinate_scale(q):
             k = int(np.argmax(np.abs(phi)))
             names = list(getattr(system, "constraint_names", []) or [f"Phi[{i}]" for i in range(system.n_c)])
-            raise ValueError(f"{system.name}: linearize needs an assembled state; constraint {names[k]!r} is violated by {phi[k]:.3e}")
+            raise InputError(f"{system.name}: linearize needs an assembled state; constraint {names[k]!r} is violated by {phi[k]:.3e}")
     a, lam_kkt = accelerations(system, t, q, v)
     lam = lam_kkt if lam is None else np.asarray(lam, float)
     M = as_dense(system.M(t, q))

@@ -172,6 +172,9 @@ class BodyStates:
     rdot : ndarray, shape (n_bodies + 1, d)
     w : ndarray, shape (n_bodies + 1, n_rot)
         θ̇ (planar) or body-frame ω̄ (spatial).
+    x, xdot : ndarray, shape (n_extra,)
+        Values and rates of the model's extra coordinates (path parameters and the like), in
+        the order they were added; element kinds that act on them index these arrays.
     """
 
     space: Space
@@ -179,9 +182,12 @@ class BodyStates:
     A: Array
     rdot: Array
     w: Array
+    x: Array = field(default_factory=lambda: np.zeros(0))
+    xdot: Array = field(default_factory=lambda: np.zeros(0))
 
     @classmethod
     def from_coordinates(cls, space: Space, n_bodies: int, q: Array, v: Array | None) -> BodyStates:
+        """Body states from the model's coordinate vectors (extra coordinates follow the bodies)."""
         nb = n_bodies
         qb = np.empty((nb + 1, space.n_q))
         qb[:nb] = q[: nb * space.n_q].reshape(nb, space.n_q)
@@ -191,9 +197,12 @@ class BodyStates:
         A = space.rotation(qb)
         r = qb[:, : space.dim]
         vb = np.zeros((nb + 1, space.n_v))
+        x = np.asarray(q[nb * space.n_q:], float)
+        xdot = np.zeros(len(x))
         if v is not None:
             vb[:nb] = v[: nb * space.n_v].reshape(nb, space.n_v)
-        return cls(space, r, A, vb[:, : space.dim], vb[:, space.dim :])
+            xdot = np.asarray(v[nb * space.n_v:], float)
+        return cls(space, r, A, vb[:, : space.dim], vb[:, space.dim :], x, xdot)
 
     # --- point kinematics for element arrays (index arrays into bodies) -------------------
     def point(self, b: NDArray[np.int64], s: Array) -> Array:

@@ -25,8 +25,10 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from . import frames
+from .assembly import assemble as assemble_model
 from .bodies import PLANAR, SPATIAL, Body, BodyStates, Space
 from .constraints import PrimitiveKind
+from .errors import ModelError, RedundantConstraintError
 from .forces import ForceElement, ForceJacobian, ForceKind
 from .joints import (
     Cylindrical,
@@ -83,22 +85,6 @@ def _select_csr_builder():
 _make_csr = _select_csr_builder()
 
 
-class ModelError(ValueError):
-    """Invalid model definition; the message names the element at fault."""
-
-
-class RedundantConstraintError(ModelError):
-    """Dependent constraint equations; ``dependent`` lists their names."""
-
-    def __init__(self, message: str, dependent: list[str]):
-        super().__init__(message)
-        self.dependent = dependent
-
-
-class AssemblyError(ModelError):
-    """The configuration cannot be assembled (Newton on Φ = 0 did not converge)."""
-
-
 @dataclass
 class ExtraCoordinate:
     name: str
@@ -108,19 +94,47 @@ class ExtraCoordinate:
 
 
 class BuildContext:
-    """What element compilers may ask for at build time (body indices, initial frames)."""
+    """What element compilers may ask for at build time (body and coordinate indices, initial frames).
 
-    def __init__(self, space: Space, body_names: list[str], bs0: BodyStates):
+    Attributes
+    ----------
+    space : Space
+    n_bodies : int
+        Number of bodies; the ground has index ``n_bodies``.
+    extra_names : list of str
+        Extra coordinates in model order (their velocity index is ``n_bodies·n_v_body + k``).
+    bs0 : BodyStates
+        Body poses and extra coordinates at the initial configuration.
+    """
+
+    def __init__(self, space: Space, body_names: list[str], bs0: BodyStates, extra_names: list[str] | None = None):
         self.space = space
+        self.n_bodies = len(body_names)
         self._index = {n: k for k, n in enumerate(body_names)}
         self._index[GROUND] = len(body_names)
+        self.extra_names = list(extra_names or [])
+        self._extra = {n: k for k, n in enumerate(self.extra_names)}
         self.bs0 = bs0
 
     def index(self, body: str, element: str) -> int:
+        """Index of ``body`` (``n_bodies`` for the ground); :class:`ModelError` naming ``element``."""
         try:
             return self._index[body]
         except KeyError:
             raise ModelError(f"element {element!r} refers to unknown body {body!r}") from None
+
+    def coordinate_index(self, coordinate: str, element: str) -> int:
+        """Index of an extra coordinate among the model's extra coordinates (0 for the first)."""
+        try:
+            return self._extra[coordinate]
+        except KeyError:
+            known = ", ".join(self.extra_names) or "none"
+            raise ModelError(f"element {element!r} refers to unknown coordinate {coordinate!r} "
+                             f"(extra coordinates of the model: {known})") from None
+
+    def velocity_index(self, coordinate: str, element: str) -> int:
+        """Index of an extra coordinate in the model's velocity (and generalized-force) vector."""
+        return self.n_bodies * self.space.n_v + self.coordinate_index(coordinate, element)
 
     def local_point(self, b: int, p: Array) -> Array:
         return self.bs0.A[b].T @ (np.asarray(p, float) - self.bs0.r[b])
@@ -347,9 +361,7 @@ class ModelBuilder:
             raise ModelError(f"model {self.name!r} has no bodies")
         model = Model._from_builder(self)
         if assemble:
-            from .analysis import assemble as _assemble
-
-            model = _assemble(model)
+            model = assemble_model(model)
         model._check_initial(tol)
         model._check_redundancy(redundant, tol)
         model._freeze()
@@ -441,7 +453,7 @@ class Model(ConstrainedSystem):
         self._Qg = np.concatenate([Qg.ravel(), np.zeros(ne)])
         # compile joints ------------------------------------------------------------------------
         bs0 = BodyStates.from_coordinates(sp_, nb, q0, v0)
-        ctx = BuildContext(sp_, self.body_names, bs0)
+        ctx = BuildContext(sp_, self.body_names, bs0, self.extra_names)
         self._ctx_names = self.body_names
         groups: OrderedDict[type, list] = OrderedDict()
         self.joints = tuple(b.joints.values())
@@ -650,30 +662,57 @@ class Model(ConstrainedSystem):
         return self._M
 
     def _force_accumulate(self, bs: BodyStates, t: float) -> Array:
+        """Sum of every force kind's generalized forces, shape (n_v,) (gravity and gyroscopic excluded)."""
         nb, nvb = self.n_bodies, self.space.n_v
         acc = np.zeros((nb + 1, nvb))
+        accx = np.zeros(len(self.extra_names))
         for fk in self.force_kinds:
             ev = fk.evaluate(bs, t)
             np.add.at(acc, ev.bodies, ev.Qb)
-        return acc[:nb]
+            if len(ev.coords):
+                np.add.at(accx, ev.coords, ev.Qx)
+        return np.concatenate([acc[:nb].ravel(), accx])
 
     def Q(self, t: float, q: Array, v: Array) -> Array:
         Q = self._Qg.copy()
-        nb, nvb = self.n_bodies, self.space.n_v
+        nb = self.n_bodies
         if self.space.dim == 3 and nb:
             w = v[: nb * 6].reshape(nb, 6)[:, 3:]
             Jw = np.einsum("nij,nj->ni", self._J, w)
             Q[: nb * 6].reshape(nb, 6)[:, 3:] -= np.cross(w, Jw)
         if self.force_kinds:
             bs = self.body_states(q, v)
-            Q[: nb * nvb] += self._force_accumulate(bs, t).ravel()
+            Q += self._force_accumulate(bs, t)
         return Q
+
+    # --- search state of stateful force kinds (see core.forces.protocol) -----------------------
+    @property
+    def stateful(self) -> bool:
+        """True when a force kind keeps a search state (integrators then call the hooks below)."""
+        return any(fk.stateful for fk in self.force_kinds)
+
+    def begin_run(self, t: float, q: Array, v: Array) -> None:
+        """A run starts at ``(t, q, v)``: reset the search state of every stateful force kind."""
+        kinds = [fk for fk in self.force_kinds if fk.stateful]
+        if kinds:
+            bs = self.body_states(q, v)
+            for fk in kinds:
+                fk.reset_state(bs, t)
+
+    def accept_step(self, t: float, q: Array, v: Array) -> None:
+        """An integrator accepted a step ending at ``(t, q, v)``: update the search states."""
+        kinds = [fk for fk in self.force_kinds if fk.stateful]
+        if kinds:
+            bs = self.body_states(q, v)
+            for fk in kinds:
+                fk.accept_step(bs, t)
 
     def _force_jacobians(self, t, q, v):
         """Sparse (Q_q, Q_v) from analytic kind Jacobians; None if any kind lacks one."""
         nvb, nb = self.space.n_v, self.n_bodies
         bs = self.body_states(q, v)
         rows, cols, Kq, Kv = [], [], [], []
+        extra_i, extra_j, extra_q, extra_v = [], [], [], []
         for fk in self.force_kinds:
             jac: ForceJacobian | None = fk.jacobian(bs, t)
             if jac is None:
@@ -682,6 +721,12 @@ class Model(ConstrainedSystem):
             cols.append(jac.cols)
             Kq.append(jac.Kq)
             Kv.append(jac.Kv)
+            if jac.entries is not None:
+                ei, ej, eq, ev = (np.asarray(a) for a in jac.entries)
+                extra_i.append(ei)
+                extra_j.append(ej)
+                extra_q.append(eq)
+                extra_v.append(ev)
         if self.space.dim == 3 and nb:
             w = v[: nb * 6].reshape(nb, 6)[:, 3:]
             Jw = np.einsum("nij,nj->ni", self._J, w)
@@ -692,8 +737,9 @@ class Model(ConstrainedSystem):
             cols.append(idx)
             Kq.append(np.zeros((nb, 6, 6)))
             Kv.append(G)
+        shape = (self.n_v, self.n_v)
         if not rows:
-            Z = sp.csr_matrix((self.n_v, self.n_v))
+            Z = sp.csr_matrix(shape)
             return Z, Z
         r = np.concatenate(rows)
         c = np.concatenate(cols)
@@ -701,9 +747,12 @@ class Model(ConstrainedSystem):
         r, c = r[keep], c[keep]
         I = (r[:, None, None] * nvb + np.arange(nvb)[None, :, None]) + 0 * np.arange(nvb)[None, None, :]
         Jc = (c[:, None, None] * nvb + np.arange(nvb)[None, None, :]) + 0 * np.arange(nvb)[None, :, None]
-        shape = (self.n_v, self.n_v)
-        Qq = sp.csr_matrix((np.concatenate(Kq)[keep].ravel(), (I.ravel(), Jc.ravel())), shape=shape)
-        Qv = sp.csr_matrix((np.concatenate(Kv)[keep].ravel(), (I.ravel(), Jc.ravel())), shape=shape)
+        ii, jj = [I.ravel()] + extra_i, [Jc.ravel()] + extra_j
+        dq = [np.concatenate(Kq)[keep].ravel()] + extra_q
+        dv = [np.concatenate(Kv)[keep].ravel()] + extra_v
+        ii, jj = np.concatenate(ii), np.concatenate(jj)
+        Qq = sp.csr_matrix((np.concatenate(dq), (ii, jj)), shape=shape)
+        Qv = sp.csr_matrix((np.concatenate(dv), (ii, jj)), shape=shape)
         return Qq, Qv
 
     def Q_q(self, t, q, v):

@@ -42,6 +42,8 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
+from .errors import ModelError
+
 Array = NDArray[np.float64]
 
 
@@ -154,6 +156,19 @@ class ConstrainedSystem(ABC):
         """Both ``(Q_q, Q_v)``; systems with analytic Jacobians override this with one pass."""
         return self.Q_q(t, q, v), self.Q_v(t, q, v)
 
+    # --- search state of stateful elements (no-ops unless a system keeps one) -----------------
+    def begin_run(self, t: float, q: Array, v: Array) -> None:
+        """A run starts at ``(t, q, v)`` (integrators call this once, on construction)."""
+
+    def accept_step(self, t: float, q: Array, v: Array) -> None:
+        """An integrator accepted a step ending at ``(t, q, v)``.
+
+        Called after accepted steps only — never for rejected attempts, stage evaluations,
+        Newton iterates or dense output — so a system whose elements keep a search state (a
+        contact search's warm start) evaluates the same force at the same ``(t, q, v)``
+        throughout a step (:mod:`core.forces.protocol`).
+        """
+
     # --- diagnostics ----------------------------------------------------------------------
     def energy(self, t: float, q: Array, v: Array) -> float | None:
         """Total mechanical energy [J] where defined (kinetic + potential), else None."""
@@ -177,18 +192,18 @@ class ConstrainedSystem(ABC):
         return np.asarray(self.Phi_q(t, q) @ v - self.nu(t, q))
 
     def check_sizes(self) -> None:
-        """Validate the declared sizes against the initial state; raise ValueError naming the field."""
+        """Validate the declared sizes against the initial state; :class:`ModelError` naming the field."""
         if np.shape(self.q0) != (self.n_q,):
-            raise ValueError(f"{self.name}: q0 has shape {np.shape(self.q0)}, expected ({self.n_q},)")
+            raise ModelError(f"{self.name}: q0 has shape {np.shape(self.q0)}, expected ({self.n_q},)")
         if np.shape(self.v0) != (self.n_v,):
-            raise ValueError(f"{self.name}: v0 has shape {np.shape(self.v0)}, expected ({self.n_v},)")
+            raise ModelError(f"{self.name}: v0 has shape {np.shape(self.v0)}, expected ({self.n_v},)")
         for label, names, n in (
             ("coordinate_names", self.coordinate_names, self.n_q),
             ("velocity_names", self.velocity_names, self.n_v),
             ("constraint_names", self.constraint_names, self.n_c),
         ):
             if len(names) != n:
-                raise ValueError(f"{self.name}: {label} has {len(names)} entries, expected {n}")
+                raise ModelError(f"{self.name}: {label} has {len(names)} entries, expected {n}")
 
 
 def as_dense(A: Array | sp.spmatrix) -> Array:

@@ -49,7 +49,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._ppoly import concatenate
+from core.curves import concatenate
+
 from .profiles import WheelProfile
 from .track import RailMounting, Track
 

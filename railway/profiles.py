@@ -48,9 +48,8 @@ from pathlib import Path
 
 import numpy as np
 
+from core.curves import PiecewisePoly
 from core.paths import data_path
-
-from ._ppoly import PiecewisePoly
 
 __all__ = [
     "DATA_DIR",

@@ -25,9 +25,22 @@ interpolated by a C2 cubic spline, displace the centreline in the frame::
     r'(s) = (X', Y', 0) + y_i' n + z_i' b + omega x (y_i n + z_i b)
 
 s stays the arc length of the design line (irregularities are small; the usual convention of
-vehicle-dynamics codes).  All quantities are stored as one vector-valued piecewise quintic
-Hermite polynomial (exact for psi, phi and the cubic irregularity spline) and evaluated with
-their first and second derivatives in one vectorised call.
+vehicle-dynamics codes).  psi, phi, X, Y and the irregularities are stored as one vector-valued
+piecewise quintic Hermite polynomial (exact for psi, phi and the cubic irregularity spline) and
+evaluated with their first and second derivatives in one vectorised call; ``Track.evaluate``
+assembles the frame from them exactly (R orthonormal to round-off).
+
+The fast path of the contact search (``Track.evaluate_raw``) uses the frame table of
+:class:`core.curves.TabulatedFramedCurve`: r, R and omega as quintic Hermite pieces from their
+exact values and first two derivatives (r', r'', omega', omega'' from the formulas above and
+below, one-sided at segment joints) at both ends of every interval.  ``Track`` is a
+:class:`core.curves.FramedCurve`, the interface it shares with other domains.  The derivatives
+of the Darboux vector that the table needs are::
+
+    omega' = (phi'' c_psi - phi' s_psi kappa, phi'' s_psi + phi' c_psi kappa, kappa')
+    omega'' = (-2 phi'' s_psi kappa - phi' (c_psi kappa^2 + s_psi kappa'),
+               2 phi'' c_psi kappa + phi' (-s_psi kappa^2 + c_psi kappa'), 0)
+    (phi and kappa linear in s inside a segment, so phi''' = kappa'' = 0)
 
 Rail mounting
 -------------
@@ -49,21 +62,27 @@ EN 13848-1:2019, Track geometry quality (gauge measured 14 mm below the running 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from ._ppoly import PiecewisePoly, quintic_hermite_coeffs
+from core.curves import (
+    CurveFrame,
+    FramedCurve,
+    PiecewisePoly,
+    TabulatedFramedCurve,
+    quintic_hermite_coeffs,
+)
+
 from .profiles import RailProfile
 
 __all__ = [
-    "Straight",
     "Curve",
-    "Transition",
     "Irregularities",
+    "RailMounting",
+    "Straight",
     "Track",
     "TrackFrame",
-    "RailMounting",
+    "Transition",
     "parse_inclination",
 ]
 
@@ -140,8 +159,12 @@ class Irregularities:
 
 
 @dataclass
-class TrackFrame:
+class TrackFrame(CurveFrame):
     """Track frame and derivatives at arc lengths s (arrays over N points).
+
+    A :class:`core.curves.CurveFrame` (r, r', r'', R = [t, n, b], omega, omega') with the
+    railway quantities of the design line; the normal n is the lateral direction (to the left)
+    and the binormal b is up.
 
     Attributes
     ----------
@@ -155,31 +178,19 @@ class TrackFrame:
         kappa (1/m), phi (rad), psi (rad).
     """
 
-    position: np.ndarray
-    dposition: np.ndarray
-    ddposition: np.ndarray
-    R: np.ndarray
-    omega: np.ndarray
-    domega: np.ndarray
     curvature: np.ndarray
     cant_angle: np.ndarray
     heading: np.ndarray
 
     @property
-    def tangent(self):
-        return self.R[:, :, 0]
-
-    @property
     def lateral(self):
+        """Lateral direction n (to the left), (N, 3); the frame's normal."""
         return self.R[:, :, 1]
 
     @property
     def up(self):
+        """Up direction b, (N, 3); the frame's binormal."""
         return self.R[:, :, 2]
-
-    def dR(self):
-        """dR/ds = [omega]x R, (N, 3, 3)."""
-        return np.cross(self.omega[:, None, :], np.swapaxes(self.R, 1, 2)).swapaxes(1, 2)
 
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
@@ -191,8 +202,13 @@ def _cross(a, b):
     return a[..., _I1] * b[..., _I2] - a[..., _I2] * b[..., _I1]
 
 
-class Track:
+class Track(FramedCurve):
     """Track centreline from segments, with cant and optional irregularities.
+
+    A :class:`core.curves.FramedCurve`: ``evaluate`` assembles the frame exactly from the
+    heading, cant and irregularity table (module docstring) and returns a :class:`TrackFrame`;
+    ``evaluate_raw`` is the fast path of the frame table ``frame_table``
+    (:class:`core.curves.TabulatedFramedCurve`).
 
     Parameters
     ----------
@@ -204,7 +220,21 @@ class Track:
         Largest interval of the internal piecewise-polynomial table (m).
     origin : (3,) array_like, heading : float
         Start point (m) and heading (rad) of the centreline.
+
+    Attributes
+    ----------
+    length : float
+        Length of the design line (m); s runs from 0 to ``length``.
+    s_joints : (n_segments + 1,) ndarray
+        Arc lengths of the segment ends (m).
+    pp : PiecewisePoly
+        Base table of (psi, phi, X, Y, y_i, z_i).
+    frame_table : TabulatedFramedCurve
+        Frame table of r, R and omega over the same node grid.
     """
+
+    name = "track"
+    closed = False
 
     def __init__(self, segments, cant_base=1.5, irregularities=None, max_step=2.0,
                  origin=(0.0, 0.0, 0.0), heading=0.0):
@@ -326,30 +356,31 @@ class Track:
         ddb = np.column_stack([ddb, ib[2]])
         c = quintic_hermite_coeffs(h[:, None], fa, da, dda, fb, db, ddb)  # (n, 6 comps, 6)
         self.pp = PiecewisePoly(grid, np.transpose(c, (0, 2, 1)))
-        # frame table for the contact search: r (3), R (9), omega (3) as quintic Hermite
-        # pieces from their exact values and first two derivatives at both ends of every
-        # interval, so that one evaluation gives r, r', r'', R, omega and omega'
+        # frame table for the contact search: r, R and omega as quintic Hermite pieces from
+        # their exact values and first two derivatives at both ends of every interval (one-sided
+        # at segment joints), so that one evaluation gives r, r', r'', R, omega and omega'
         idx = np.arange(h.size)
-        ends_ = []
+        frames = []
         for t in (np.zeros_like(h), h):
             pos, dpos, ddpos, R, om, dom, ddom = self._assemble(self.pp.eval_piece(idx, t), True)
-            dR = _cross(om[:, None, :], np.swapaxes(R, 1, 2)).swapaxes(1, 2)
-            ddR = (_cross(dom[:, None, :], np.swapaxes(R, 1, 2))
-                   + _cross(om[:, None, :], np.swapaxes(dR, 1, 2))).swapaxes(1, 2)
-            n = h.size
-            ends_.append((np.column_stack([pos, R.reshape(n, 9), om]),
-                          np.column_stack([dpos, dR.reshape(n, 9), dom]),
-                          np.column_stack([ddpos, ddR.reshape(n, 9), ddom])))
-        (fa, da, dda), (fb, db, ddb) = ends_
-        c = quintic_hermite_coeffs(h[:, None], fa, da, dda, fb, db, ddb)
-        self.pp_frame = PiecewisePoly(grid, np.transpose(c, (0, 2, 1)))
+            frames.append(CurveFrame(pos, dpos, ddpos, R, om, dom, ddomega=ddom))
+        self.frame_table = TabulatedFramedCurve(grid, *frames, name=self.name)
+
+    @property
+    def pp_frame(self) -> PiecewisePoly:
+        """The frame table's piecewise polynomial (layout in :class:`TabulatedFramedCurve`)."""
+        return self.frame_table.table
 
     # -- evaluation ---------------------------------------------------------------------
     def evaluate(self, s) -> TrackFrame:
-        """Track frame and derivatives at arc lengths s (m), any 1-D array."""
-        s = np.atleast_1d(np.asarray(s, dtype=float)).reshape(-1)
-        if np.any(~np.isfinite(s)):
-            raise ValueError(f"track: non-finite arc length {s[~np.isfinite(s)][0]!r}")
+        """Track frame and derivatives at arc lengths s (m), any 1-D array.
+
+        Assembled exactly from the base table (R orthonormal to round-off); raises ValueError
+        naming a non-finite arc length.
+        """
+        return super().evaluate(s)
+
+    def _evaluate(self, s):
         return self._frame(s, second=True)
 
     def _frame(self, s, second=False):
@@ -362,16 +393,16 @@ class Track:
         o = self.pp.eval_raw(s)
         return TrackFrame(pos, dpos, ddpos, R, om, dom, o[:, 6], o[:, 1], o[:, 0])
 
-    def _frame_fast(self, s):
+    def evaluate_raw(self, s):
         """(r, r', r'', R, omega, omega') from the frame table (one vectorised evaluation).
 
         R is interpolated (quintic Hermite of its exact values and derivatives): orthonormal to
-        round-off for the interval lengths used (<= max_step).
+        round-off for the interval lengths used (<= max_step).  See
+        :meth:`core.curves.TabulatedFramedCurve.evaluate_raw`.
         """
-        o = self.pp_frame.eval_raw(s)
-        M = s.shape[0]
-        return (o[:, 0:3], o[:, 15:18], o[:, 30:33], o[:, 3:12].reshape(M, 3, 3), o[:, 12:15],
-                o[:, 27:30])
+        return self.frame_table.evaluate_raw(s)
+
+    _frame_fast = evaluate_raw  # name used by railway.contact_search
 
     def _assemble(self, o, third):
         """Frame quantities from raw (value, d1, d2) rows of the base table."""

@@ -52,6 +52,7 @@ import scipy.integrate as _si
 
 from .. import compiled as _c
 from .base import STATUS_FAILED, STATUS_FINISHED, STATUS_RUNNING, Integrator, register
+from ..errors import InputError
 from .index1 import DEFAULT_BAUMGARTE
 
 _jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
@@ -319,15 +320,15 @@ class CompiledRK(Integrator):
             self.alpha = float(o.get("alpha", DEFAULT_BAUMGARTE))
             self.beta = float(o.get("beta", DEFAULT_BAUMGARTE))
             if not (self.alpha >= 0 and np.isfinite(self.beta)):
-                raise ValueError(f"{self.name}: Baumgarte alpha must be ≥ 0 and beta finite, got {self.alpha}, {self.beta}")
+                raise InputError(f"{self.name}: Baumgarte alpha must be ≥ 0 and beta finite, got {self.alpha}, {self.beta}")
         self.projection_tol = float(o.get("projection_tol", self.atol))
         self.max_projection_iter = int(o.get("max_projection_iter", 10))
         if not self.projection_tol > 0:
-            raise ValueError(f"{self.name}: projection_tol must be > 0, got {self.projection_tol}")
+            raise InputError(f"{self.name}: projection_tol must be > 0, got {self.projection_tol}")
         actions = {"off": STIFF_OFF, "warn": STIFF_WARN, "fail": STIFF_FAIL}
         stiffness = o.get("stiffness", DEFAULT_STIFFNESS)
         if stiffness not in actions:
-            raise ValueError(f"{self.name}: stiffness must be one of {sorted(actions)}, got {stiffness!r}")
+            raise InputError(f"{self.name}: stiffness must be one of {sorted(actions)}, got {stiffness!r}")
         self._stiff_action = actions[stiffness]
         self._stiff_bound = STIFF_BOUND["dop853" if self.scipy_solver is _si.DOP853 else "rk45"]
         #: time [s] where the stiffness test first fired (None if it never did)
@@ -363,10 +364,10 @@ class CompiledRK(Integrator):
             it = _c.project(self._cd, self._ws, self._y[:nq], self._y[nq:], self.projection_tol,
                             self.max_projection_iter, self._cnt)
             if it < 0:
-                raise ValueError(f"{self.name}: initial state of {system.name!r} cannot be projected onto the constraints")
+                raise InputError(f"{self.name}: initial state of {system.name!r} cannot be projected onto the constraints")
         st = self._evaluate(self.t, self._y, self._f)
         if st != _c.OK:
-            raise ValueError(f"{self.name}: right-hand side fails at the initial state of {system.name!r}: "
+            raise InputError(f"{self.name}: right-hand side fails at the initial state of {system.name!r}: "
                              f"{_c.STATUS_MESSAGES[st]}")
         if self.h is not None:
             self._h_abs = min(self.h, self.t_bound - self.t)
@@ -409,7 +410,7 @@ class CompiledRK(Integrator):
             h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
         h = min(100.0 * h0, h1, interval, self.max_step)
         if not np.isfinite(h) or h <= 0:
-            raise ValueError(f"{self.name}: no usable initial step at t = {t0:g} s for {self.system.name!r} "
+            raise InputError(f"{self.name}: no usable initial step at t = {t0:g} s for {self.system.name!r} "
                              "(non-finite right-hand side near the initial state)")
         return h
 

@@ -351,7 +351,8 @@ class RadauGGL(Integrator):
         msg = None
         while not step_accepted:
             if h_abs < min_step:
-                return False, f"step size {h_abs:.3g} s too small (minimum {min_step:.3g} s)"
+                why = f" after: {msg}" if msg else ""
+                return False, f"step size {h_abs:.3g} s too small (minimum {min_step:.3g} s){why}"
             h = h_abs
             t_new = t + h
             if t_new - self.t_bound > 0:

@@ -63,9 +63,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..dynamics import accelerations
+from ..dynamics import SaddleSolver, accelerations, project
+from ..errors import InputError
 from .base import Integrator, register
-from .index1 import SaddleSolver, project
 
 _S6 = np.sqrt(6.0)
 
@@ -129,7 +129,7 @@ class HalfExplicitRK(Integrator):
         self._s = len(b)
         sub = np.array([self._A[i, i - 1] for i in range(1, self._s + 1)])
         if np.any(sub == 0):
-            raise ValueError(f"{self.name}: tableau needs a_(i,i-1) != 0 for every stage")
+            raise InputError(f"{self.name}: tableau needs a_(i,i-1) != 0 for every stage")
         self.projection = bool(self.options.get("projection", False))
         self.projection_tol = float(self.options.get("projection_tol", self.atol))
         self._saddle = SaddleSolver(system, self.counters)
@@ -185,7 +185,7 @@ class HalfExplicitRK(Integrator):
         q1, v1 = sys_.normalize(Qi), Vi
         t1 = t0 + h
         if self.projection:
-            q1, v1, it = project(sys_, self._saddle, t1, q1, v1, self.projection_tol)
+            q1, v1, it = project(sys_, t1, q1, v1, self.projection_tol, solver=self._saddle)
             if it < 0:
                 return False, f"coordinate projection did not reach ‖Φ‖ ≤ {self.projection_tol:g} at t = {t1:.6g} s"
             self._start = None

@@ -30,7 +30,7 @@ Three variants of every solver ``rk45, dop853, radau, bdf, lsoda`` are registere
     Ch. 5): positions onto ``Φ = 0`` by simplified Gauss–Newton iterations for the
     M-weighted minimum-norm correction along velocity-space increments ``q ⊕ Δ``
     (tolerance ``projection_tol``, default ``atol``), then velocities onto ``Φ_q v = ν`` by the
-    M-orthogonal projection, then ``system.normalize``.  See :func:`project`.
+    M-orthogonal projection, then ``system.normalize`` (:func:`core.dynamics.project`).
 
 Solver reset after a projection (what is done and what it costs)
     ``RK45``, ``DOP853`` and ``Radau``: ``solver.y`` is overwritten and the cached derivative
@@ -75,211 +75,11 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.integrate as _si
-import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
-from ..dynamics import kkt_matrix, solve_kkt
-from ..dynamics import constraint_terms
+from ..dynamics import SaddleSolver, constraint_terms, project
+from ..errors import InputError
 from .base import Integrator, register
-
-_DENSE_MAX = 400
-
-
-def _wants_minimum_norm(system) -> bool:
-    """Redundant rows kept in the model (same rule as :func:`core.dynamics.accelerations`)."""
-    return bool(len(getattr(system, "redundant_rows", ())) and getattr(system, "_active_rows", None) is None)
-
-
-class SaddleSolver:
-    """Reusable solver for ``[[M, Gᵀ], [J, 0]]`` systems of one constrained system.
-
-    Parameters
-    ----------
-    system : ConstrainedSystem
-    counters : dict
-        The integrator's counters; ``n_factor`` is incremented per factorisation.
-    """
-
-    def __init__(self, system, counters: dict):
-        self.system = system
-        self.counters = counters
-        self.minimum_norm = _wants_minimum_norm(system)
-        self._Minv = None
-        self._M = None
-        self._minv_diag = None  # diagonal M: 1/diag(M)
-        self._Minv_dense = None
-        self.dense = system.n_v <= _DENSE_MAX
-        if system.mass_is_constant:
-            M = system.M(0.0, system.q0)
-            self._M = M
-            if not self.minimum_norm and system.n_v:
-                try:
-                    Md = M.toarray() if sp.issparse(M) else np.asarray(M, float)
-                    off = Md - np.diag(np.diag(Md))
-                    if not np.any(off) and np.all(np.diag(Md) > 0):
-                        self._minv_diag = 1.0 / np.diag(Md)
-                        self._Minv = sp.diags(self._minv_diag, format="csr")
-                    else:
-                        Minv = spla.inv(sp.csc_matrix(Md)) if sp.issparse(M) else np.linalg.inv(Md)
-                        dense = Minv.toarray() if sp.issparse(Minv) else np.asarray(Minv)
-                        if np.all(np.isfinite(dense)) and np.allclose(Md @ dense, np.eye(system.n_v), atol=1e-9):
-                            self._Minv = sp.csr_matrix(dense)
-                            self._Minv_dense = dense if self.dense else None
-                except (RuntimeError, np.linalg.LinAlgError, ValueError):
-                    self._Minv = None
-
-    def mass(self, t, q):
-        """``M(t, q)`` (cached when constant)."""
-        return self._M if self._M is not None else self.system.M(t, q)
-
-    def factor(self, t, q, J, G=None):
-        """Factorisation object with ``solve(f, g) -> (x, μ)`` for ``[[M, Gᵀ], [J, 0]]``."""
-        self.counters["n_factor"] += 1
-        return _Factor(self, t, q, J, J if G is None else G, G is None)
-
-    def solve(self, t, q, J, f, g, G=None):
-        """One-off solve of ``[[M, Gᵀ], [J, 0]] [x; μ] = [f; g]``."""
-        return self.factor(t, q, J, G).solve(f, g)
-
-
-class _Factor:
-    def __init__(self, owner: SaddleSolver, t, q, J, G, symmetric: bool):
-        self.owner = owner
-        self.n_c = J.shape[0]
-        self.M = owner.mass(t, q)
-        self.J, self.G = J, G
-        self._J_orig = J
-        self.mode = None
-        Minv = owner._Minv
-        if self.n_c == 0:
-            self.mode = "free"
-            return
-        if Minv is not None:
-            try:
-                if owner.dense:
-                    Jd = J.toarray() if sp.issparse(J) else np.asarray(J, float)
-                    Gd = Jd if G is J else (G.toarray() if sp.issparse(G) else np.asarray(G, float))
-                    self.J = Jd
-                    if owner._minv_diag is not None:
-                        self.MGt = owner._minv_diag[:, None] * Gd.T
-                    else:
-                        self.MGt = owner._Minv_dense @ Gd.T
-                    Sd = Jd @ self.MGt
-                    if symmetric:
-                        if not np.all(np.isfinite(Sd)):
-                            raise np.linalg.LinAlgError("non-finite Schur complement")
-                        self.fac = sla.cho_factor(Sd, check_finite=False)
-                        self.mode = "chol"
-                    else:
-                        lu = sla.lu_factor(Sd, check_finite=True)
-                        d = np.abs(np.diag(lu[0]))
-                        if d.min() <= 1e-13 * max(d.max(), 1e-300):
-                            raise np.linalg.LinAlgError("singular Schur complement")
-                        self.fac = lu
-                        self.mode = "lu"
-                else:
-                    self.MGt = Minv @ sp.csr_matrix(G).T
-                    self.fac = spla.splu(sp.csc_matrix(J @ self.MGt))
-                    self.mode = "splu"
-            except (np.linalg.LinAlgError, RuntimeError, ValueError):
-                self.mode = None
-                self.J = J
-        if self.mode is None and not owner.minimum_norm:
-            try:
-                K = kkt_matrix(self.M, J) if G is J else sp.bmat(
-                    [[sp.csr_matrix(self.M), sp.csr_matrix(G).T], [sp.csr_matrix(J), None]], format="csc")
-                with np.errstate(all="raise"):
-                    self.fac = spla.splu(sp.csc_matrix(K))
-                self.K = K
-                self.mode = "kkt"
-            except (RuntimeError, FloatingPointError, ValueError):
-                self.mode = None
-        if self.mode is None:
-            self.mode = "lstsq"
-
-    def solve(self, f, g):
-        n_v = len(f)
-        mode = self.mode
-        if mode == "free":
-            if self.owner._minv_diag is not None:  # constant diagonal M: cached inverse
-                return self.owner._minv_diag * f, np.zeros(0)
-            Md = self.M.toarray() if sp.issparse(self.M) else np.asarray(self.M)
-            return np.linalg.solve(Md, f), np.zeros(0)
-        Minv = self.owner._Minv
-        if mode in ("chol", "lu", "splu"):
-            x0 = self.owner._minv_diag * f if self.owner._minv_diag is not None else Minv @ f
-            r = self.J @ x0 - g
-            if mode == "chol":
-                mu = sla.cho_solve(self.fac, r, check_finite=False)
-            elif mode == "lu":
-                mu = sla.lu_solve(self.fac, r, check_finite=False)
-            else:
-                mu = self.fac.solve(r)
-            return x0 - self.MGt @ mu, mu
-        if mode == "kkt":
-            rhs = np.concatenate([f, g])
-            sol = self.fac.solve(rhs)
-            res = self.K @ sol - rhs
-            if np.all(np.isfinite(sol)) and np.linalg.norm(res) <= 1e-8 * (1.0 + np.linalg.norm(rhs)):
-                return sol[:n_v], sol[n_v:]
-        if self.G is self.J:
-            return solve_kkt(self.M, self.J, f, g, minimum_norm=True)
-        # non-symmetric saddle point with rank-deficient blocks: dense least squares
-        Md = self.M.toarray() if sp.issparse(self.M) else np.asarray(self.M, float)
-        Jd = self.J.toarray() if sp.issparse(self.J) else np.asarray(self.J, float)
-        Gd = self.G.toarray() if sp.issparse(self.G) else np.asarray(self.G, float)
-        K = np.block([[Md, Gd.T], [Jd, np.zeros((self.n_c, self.n_c))]])
-        sol, *_ = sla.lstsq(K, np.concatenate([f, g]), cond=1e-12, lapack_driver="gelsd")
-        return sol[:n_v], sol[n_v:]
-
-
-def project(system, solver: SaddleSolver, t: float, q, v, tol: float, max_iter: int = 10):
-    r"""Coordinate projection onto ``Φ(t, q) = 0`` and ``Φ_q v = ν`` (Eich 1993).
-
-    Positions: simplified Gauss–Newton iterations for the M-weighted minimum-norm correction,
-
-    .. math::  \begin{bmatrix} M & Φ_q^T \\ Φ_q & 0 \end{bmatrix}
-               \begin{bmatrix} Δ \\ μ \end{bmatrix} = \begin{bmatrix} 0 \\ -Φ(q^{(k)}) \end{bmatrix},
-               \qquad q^{(k+1)} = q^{(k)} ⊕ Δ,
-
-    with ``Φ_q`` and its factorisation frozen at the unprojected point, until ``‖Φ‖∞ ≤ tol``.
-    Velocities: one M-orthogonal projection at the projected positions,
-    ``[[M, Φ_qᵀ], [Φ_q, 0]] [Δv; μ] = [0; ν − Φ_q v]``.
-
-    Returns
-    -------
-    q, v : ndarray
-    n_iter : int
-        Position iterations used; ``-1`` when they did not reach ``tol`` in ``max_iter``.
-    """
-    q = system.normalize(q)
-    n_v = system.n_v
-    if system.n_c == 0:
-        return q, v, 0
-    phi = system.Phi(t, q)
-    n_iter = 0
-    if np.max(np.abs(phi)) > tol:
-        fac = solver.factor(t, q, system.Phi_q(t, q))
-        zero = np.zeros(n_v)
-        prev = np.inf
-        while True:
-            dq, _ = fac.solve(zero, -phi)
-            q = system.retract(q, dq)
-            n_iter += 1
-            phi = system.Phi(t, q)
-            err = np.max(np.abs(phi))
-            if err <= tol:
-                break
-            if n_iter >= max_iter or not np.isfinite(err) or err > 2.0 * prev:
-                return q, v, -1
-            prev = err
-        q = system.normalize(q)
-    J = system.Phi_q(t, q)
-    res = J @ v - system.nu(t, q)
-    dv, _ = solver.solve(t, q, J, np.zeros(n_v), -np.asarray(res))
-    return q, v + dv, n_iter
-
 
 # --------------------------------------------------------------------------------------------
 # index-1 ODE on top of scipy solvers
@@ -336,13 +136,13 @@ class ScipyIndex1(Integrator):
             self.alpha = float(o.get("alpha", DEFAULT_BAUMGARTE))
             self.beta = float(o.get("beta", DEFAULT_BAUMGARTE))
             if not (self.alpha >= 0 and np.isfinite(self.beta)):
-                raise ValueError(f"{self.name}: Baumgarte alpha must be ≥ 0 and beta finite, got {self.alpha}, {self.beta}")
+                raise InputError(f"{self.name}: Baumgarte alpha must be ≥ 0 and beta finite, got {self.alpha}, {self.beta}")
         else:
             self.alpha = self.beta = 0.0
         self.projection_tol = float(o.get("projection_tol", self.atol))
         self.max_projection_iter = int(o.get("max_projection_iter", 10))
         if not self.projection_tol > 0:
-            raise ValueError(f"{self.name}: projection_tol must be > 0, got {self.projection_tol}")
+            raise InputError(f"{self.name}: projection_tol must be > 0, got {self.projection_tol}")
         self._jac = o.get("jac")
         self._n_q, self._n_v = system.n_q, system.n_v
         self._saddle = SaddleSolver(system, self.counters)
@@ -350,9 +150,9 @@ class ScipyIndex1(Integrator):
         self._dense = None
         self._offsets = dict(n_jac=0)
         if self.stabilization == "projection":
-            q, v, it = project(system, self._saddle, self.t, self.q, self.v, self.projection_tol, self.max_projection_iter)
+            q, v, it = project(system, self.t, self.q, self.v, self.projection_tol, self.max_projection_iter, self._saddle)
             if it < 0:
-                raise ValueError(f"{self.name}: initial state of {system.name!r} cannot be projected onto the constraints")
+                raise InputError(f"{self.name}: initial state of {system.name!r} cannot be projected onto the constraints")
             self.q, self.v = q, v
         self._solver = self._make_solver(self.t, np.concatenate([self.q, self.v]), self.h)
 
@@ -400,7 +200,7 @@ class ScipyIndex1(Integrator):
         q, v = y[: self._n_q].copy(), y[self._n_q :].copy()
         self._dense = (solver, None, None)
         if self.stabilization == "projection":
-            qp, vp, it = project(self.system, self._saddle, t_new, q, v, self.projection_tol, self.max_projection_iter)
+            qp, vp, it = project(self.system, t_new, q, v, self.projection_tol, self.max_projection_iter, self._saddle)
             if it < 0:
                 return False, (f"coordinate projection did not reach ‖Φ‖ ≤ {self.projection_tol:g} in "
                                f"{self.max_projection_iter} iterations at t = {t_new:.6g} s")

@@ -19,7 +19,8 @@ from core import analysis as A
 from core.drivers import constant, harmonic, ramp
 from core.dynamics import accelerations
 from core.forces import AppliedTorque
-from core.model import AssemblyError, ModelBuilder
+from core.errors import AssemblyError
+from core.model import ModelBuilder
 from core.system import ConstrainedSystem
 
 G = 9.81

@@ -164,7 +164,7 @@ def test_bricard_redundancy_detected_and_named():
     # rank 29 confirmed independently by SVD
     sv = np.linalg.svd(m.Phi_q(0.0, m.q0).toarray(), compute_uv=False)
     assert np.sum(sv > 1e-9 * sv[0]) == 29
-    from core.model import RedundantConstraintError
+    from core.errors import RedundantConstraintError
 
     with pytest.raises(RedundantConstraintError) as exc:
         iftomm_a04_bricard(redundant="raise")

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from core import drivers, frames
-from core.model import ModelBuilder, ModelError, RedundantConstraintError
+from core.errors import ModelError, RedundantConstraintError
+from core.model import ModelBuilder
 
 
 def _pendulum(dim=2, **body):

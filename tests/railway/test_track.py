@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from railway.track import Curve, Irregularities, Straight, Track, Transition
+from core.curves import CurveFrame, FramedCurve, TabulatedFramedCurve
+from railway.track import Curve, Irregularities, Straight, Track, TrackFrame, Transition
 
 
 def _track(irr=False):
@@ -97,3 +98,32 @@ def test_bad_track_input():
         Irregularities([0, 1, 2, 3], [0, np.nan, 0, 0], [0, 0, 0, 0])
     with pytest.raises(ValueError, match="nan"):
         Track.straight(10.0).evaluate([1.0, np.nan])
+
+
+@pytest.mark.parametrize("irr", [False, True])
+def test_track_is_a_framed_curve_and_fast_path_matches_evaluate(irr):
+    """The track shares core's FramedCurve interface; its fast path (the frame table) agrees with
+    the exact assembly of ``evaluate``.
+
+    Interpolation error of the table: about (h |omega|)^6 / 46080 < 1e-17 for h <= 2 m and
+    |omega| < 5e-3 1/m, so the differences are round-off of the table coefficients, at most
+    about 1000 eps times the size of each quantity divided by h_min^k for its k-th derivative
+    (|r| <= 500 m, |R_ij| <= 1, max |omega|).
+    """
+    tr = _track(irr)
+    assert isinstance(tr, FramedCurve) and not tr.closed
+    assert isinstance(tr.frame_table, TabulatedFramedCurve)
+    assert tr.pp_frame is tr.frame_table.table
+    s = np.linspace(0.0, tr.length, 4001)
+    f = tr.evaluate(s)
+    assert isinstance(f, TrackFrame) and isinstance(f, CurveFrame)
+    assert np.array_equal(f.normal, f.lateral) and np.array_equal(f.binormal, f.up)
+    raw = tr.evaluate_raw(s)
+    for a, b in zip(raw, tr._frame_fast(s), strict=True):
+        assert np.array_equal(a, b)
+    h = np.min(np.diff(tr.frame_table.nodes))
+    u, om = 1000 * np.finfo(float).eps, np.max(np.abs(f.omega))
+    tols = (u * 500.0, u * 500.0 / h, u * 500.0 / h**2, u, u * om, u * om / h)
+    keys = ("position", "dposition", "ddposition", "R", "omega", "domega")
+    for a, key, tol in zip(raw, keys, tols, strict=True):
+        assert np.max(np.abs(a - getattr(f, key))) <= tol, key

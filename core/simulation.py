@@ -1,0 +1,189 @@
+r"""The simulation driver: run an integrator over a time span and record what a report needs.
+
+:func:`simulate` steps any integrator of :mod:`core.integrators` (a registered name or an
+:class:`core.integrators.Integrator` subclass) through the time span, samples the state at the
+output times from each step's dense output (or lands on them, for methods that step to outputs),
+and records at every output time
+
+* the position and velocity constraint violations ``max|Φ|`` and ``max|Φ_q v − ν|`` (plus
+  coordinate invariants such as ``|p|² − 1`` of Euler parameters),
+* the total energy, for systems that define it,
+* the multipliers (the method's own when it provides consistent ones, else the index-1 KKT
+  solution at the output state) and the joint reactions computed from them,
+
+and the run metadata (method, tolerances, counters, solve and total wall time).  A run that
+fails (NaN, divergence, an unmet tolerance, a singular matrix) returns with ``status ==
+"failed"``, the message saying where and why, everything computed up to that point and, as its
+last row, the last good state at the time where the run stopped.  Exceptions that are not
+numerical failures (:data:`core.errors.NUMERICAL_ERRORS`) propagate.
+
+The integrator protocol itself (step objects, status, counters, dense output, registry) is
+:mod:`core.integrators.base`; this module only drives it.
+"""
+
+from __future__ import annotations
+
+import time as _time
+
+import numpy as np
+
+from .dynamics import accelerations
+from .errors import NUMERICAL_ERRORS, InputError
+from .integrators.base import STATUS_FAILED, STATUS_RUNNING, Integrator, get_method
+from .results import SimulationResult
+from .system import ConstrainedSystem
+
+__all__ = ["simulate"]
+
+
+def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] = "rk45-projection", *,
+             t_eval=None, n_output: int = 201, q0=None, v0=None, rtol: float = 1e-6, atol: float = 1e-8,
+             h: float | None = None, max_step: float = np.inf, progress: bool | None = False,
+             compute_multipliers: bool = True, **options):
+    """Integrate ``system`` over ``t_span`` and return a :class:`core.results.SimulationResult`.
+
+    Output is sampled at ``t_eval`` (default ``n_output`` equally spaced times) from each step's
+    dense output.  Multipliers at output times come from the method when it provides consistent
+    ones, else from the index-1 KKT solve at the output state.  Position and velocity constraint
+    violations (max-abs over rows, plus coordinate invariants such as |p|−1) and, for
+    conservative systems, the energy are recorded at every output time.
+
+    A run that fails (NaN, divergence, unmet tolerance, exception) returns with
+    ``status == "failed"``, the message saying where, all output computed up to that point and, as
+    its last row, the last good state at the time where the run stopped.
+    """
+    cls = get_method(method)
+    t0, t_end = map(float, t_span)
+    if t_eval is None:
+        t_eval = np.linspace(t0, t_end, n_output)
+    t_eval = np.asarray(t_eval, float)
+    if np.any(np.diff(t_eval) <= 0) or t_eval[0] < t0 - 1e-14 or t_eval[-1] > t_end + 1e-12:
+        raise InputError(f"t_eval must be strictly increasing within t_span {t_span}")
+    integ = cls(system, (t0, t_end), q0, v0, rtol=rtol, atol=atol, h=h, max_step=max_step, **options)
+    ts, qs, vs, lams = [], [], [], []
+    k = 0
+    wall0 = _time.perf_counter()
+    solve_time = 0.0
+    bar = None
+    if progress is not False:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=t_end - t0, disable=None if progress is None else not progress, unit="s", desc=system.name)
+    # output at t0
+    while k < len(t_eval) and t_eval[k] <= t0 + 1e-15:
+        ts.append(t0)
+        qs.append(integ.q.copy())
+        vs.append(integ.v.copy())
+        lams.append(None)
+        k += 1
+    while integ.status == STATUS_RUNNING:
+        s0 = _time.perf_counter()
+        if integ.steps_to_output:
+            integ.advance(t_eval[k] if k < len(t_eval) else t_end)
+        else:
+            integ.step()
+        solve_time += _time.perf_counter() - s0
+        if integ.status == STATUS_FAILED:
+            break
+        if bar is not None:
+            bar.update(integ.t - integ.t_old)
+        if k < len(t_eval) and t_eval[k] <= integ.t + 1e-12 * max(1.0, abs(integ.t)):
+            try:
+                dense = integ.dense_output()
+            except NUMERICAL_ERRORS as exc:
+                integ.status = STATUS_FAILED
+                integ.message = (f"{integ.name} failed at t = {integ.t:.6g} s: dense output could not be "
+                                 f"built ({type(exc).__name__}: {exc})")
+                break
+            while k < len(t_eval) and t_eval[k] <= integ.t + 1e-12 * max(1.0, abs(integ.t)):
+                tk = t_eval[k]
+                if abs(tk - integ.t) <= 1e-12 * max(1.0, abs(integ.t)):
+                    q, v = integ.q.copy(), integ.v.copy()
+                    lam = None if integ.lam is None else np.array(integ.lam)
+                else:
+                    try:
+                        q, v = dense(tk)
+                    except NUMERICAL_ERRORS as exc:
+                        integ.status = STATUS_FAILED
+                        integ.message = (f"{integ.name} failed at t = {tk:.6g} s: dense output could not be "
+                                         f"evaluated ({type(exc).__name__}: {exc})")
+                        break
+                    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+                        integ.status = STATUS_FAILED
+                        integ.message = f"{integ.name} failed at t = {tk:.6g} s: dense output is not finite"
+                        break
+                    lam = None
+                ts.append(tk)
+                qs.append(q)
+                vs.append(v)
+                lams.append(lam)
+                k += 1
+            if integ.status == STATUS_FAILED:
+                break
+    if bar is not None:
+        bar.close()
+    if integ.status == STATUS_FAILED and (not ts or integ.t > ts[-1]):
+        # keep what was computed: the last good state, where the run stopped (not a requested time)
+        ts.append(float(integ.t))
+        qs.append(integ.q.copy())
+        vs.append(integ.v.copy())
+        lams.append(None)
+    wall = _time.perf_counter() - wall0
+    ts = np.array(ts)
+    n_t = len(ts)
+    Q = np.array(qs).reshape(n_t, system.n_q)
+    V = np.array(vs).reshape(n_t, system.n_v)
+    pos_viol = np.zeros(n_t)
+    vel_viol = np.zeros(n_t)
+    inv_viol = np.zeros(n_t)
+    energy = np.full(n_t, np.nan) if system.energy(t0, system.q0, system.v0) is not None else None
+    L = np.full((n_t, system.n_c), np.nan) if compute_multipliers else None
+    reactions: dict[str, list] = {}
+    for i in range(n_t):
+        t, q, v = ts[i], Q[i], V[i]
+        if system.n_c:
+            pos_viol[i] = np.max(np.abs(system.Phi(t, q)))
+            vel_viol[i] = np.max(np.abs(system.velocity_violation(t, q, v)))
+        inv_viol[i] = system.invariant_violation(q)
+        if energy is not None:
+            energy[i] = system.energy(t, q, v)
+        if compute_multipliers and system.n_c:
+            lam = lams[i]
+            if lam is None or not (integ.provides_multipliers and len(lam) == system.n_c):
+                try:
+                    _, lam = accelerations(system, t, q, v)
+                except NUMERICAL_ERRORS:
+                    lam = np.full(system.n_c, np.nan)
+            L[i] = lam
+            for name, val in system.reactions(t, q, lam).items():
+                reactions.setdefault(name, []).append(val)
+    reactions_arr = {n: np.array(v) for n, v in reactions.items() if len(v) == n_t}
+    meta = dict(
+        system=system.name,
+        method=cls.name,
+        rtol=rtol,
+        atol=atol,
+        h=h,
+        wall_time_s=solve_time,
+        total_time_s=wall,
+        t_end_reached=float(integ.t),
+        max_invariant_violation=float(inv_viol.max()) if n_t else 0.0,
+    )
+    return SimulationResult(
+        t=ts,
+        q=Q,
+        v=V,
+        lam=L,
+        status=integ.status,
+        message=integ.message or "",
+        counters=dict(integ.counters),
+        meta=meta,
+        coordinate_names=list(system.coordinate_names),
+        velocity_names=list(system.velocity_names),
+        constraint_names=list(system.constraint_names),
+        position_violation=np.maximum(pos_viol, inv_viol),
+        velocity_violation=vel_viol,
+        energy=energy,
+        reactions=reactions_arr,
+        reaction_names={n: system.reaction_names().get(n, []) for n in reactions_arr},
+    )

@@ -18,7 +18,7 @@ sensitive to other load on the machine) and the elapsed wall time (``time.perf_c
 
    with global re-seeding every 10, 20 and 50 calls and without re-seeding, and a cold call.
    With numba installed the compiled kernels and the numpy implementations are measured side
-   by side (the numpy forces use the reference modules railway.hertz/creepage/creep).
+   by side (the numpy forces use the reference modules core.contact_laws, railway.creepage, railway.creep).
 """
 
 from __future__ import annotations

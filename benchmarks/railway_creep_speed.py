@@ -17,7 +17,7 @@ import pandas as pd
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from railway.creep import CREEP_MODELS, get_creep_model  # noqa: E402
-from railway.hertz import hertz_from_load  # noqa: E402
+from core.contact_laws import hertz_from_load  # noqa: E402
 
 
 def _best(fn, repeat=5):

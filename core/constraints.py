@@ -125,6 +125,12 @@ class PointCoincidence(PrimitiveKind):
             out.gamma = -(bs.aq(self.bi, self.si) - bs.aq(self.bj, self.sj))
         return out
 
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_point_coincidence`)."""
+        from .compiled.elements import compile_point_coincidence
+
+        return compile_point_coincidence(self, layout)
+
 
 class Dot1(PrimitiveKind):
     """``a_iᵀ a_j − c = 0`` (two body-fixed directions at a fixed angle)."""
@@ -158,6 +164,12 @@ class Dot1(PrimitiveKind):
             g += 2.0 * np.sum(aid * ajd, 1)
             out.gamma = -g[:, None]
         return out
+
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_dot1`)."""
+        from .compiled.elements import compile_dot1
+
+        return compile_dot1(self, layout)
 
 
 class Dot2(PrimitiveKind):
@@ -196,6 +208,12 @@ class Dot2(PrimitiveKind):
             out.gamma = -g[:, None]
         return out
 
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_dot2`)."""
+        from .compiled.elements import compile_dot2
+
+        return compile_dot2(self, layout)
+
 
 class Distance(PrimitiveKind):
     """``(dᵀd − L²)/(2L) = 0`` with ``d = r_Q − r_P`` (massless rigid link of length L)."""
@@ -231,6 +249,12 @@ class Distance(PrimitiveKind):
             out.gamma = -(g / L)[:, None]
         return out
 
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_distance`)."""
+        from .compiled.elements import compile_distance
+
+        return compile_distance(self, layout)
+
 
 class PlanarAngle(PrimitiveKind):
     """``θ_j − θ_i − c = 0`` (planar relative rotation locked)."""
@@ -258,6 +282,12 @@ class PlanarAngle(PrimitiveKind):
         if "g" in what:
             out.gamma = np.zeros((self.n, 1))
         return out
+
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_planar_angle`)."""
+        from .compiled.elements import compile_planar_angle
+
+        return compile_planar_angle(self, layout)
 
 
 # --------------------------------------------------------------------------------------------
@@ -309,6 +339,12 @@ class PointPositionDriver(_Driven):
             out.gamma = (fdd - np.sum(self.u * bs.aq(self.bi, self.si), 1))[:, None]
         return out
 
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_point_position_driver`)."""
+        from .compiled.elements import compile_point_position_driver
+
+        return compile_point_position_driver(self, layout)
+
 
 class PlanarAngleDriver(_Driven):
     """``θ_j − θ_i − c − f(t) = 0`` (planar revolute angle driver)."""
@@ -336,6 +372,12 @@ class PlanarAngleDriver(_Driven):
         if "g" in what:
             out.gamma = fdd[:, None]
         return out
+
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_planar_angle_driver`)."""
+        from .compiled.elements import compile_planar_angle_driver
+
+        return compile_planar_angle_driver(self, layout)
 
 
 class SpatialAngleDriver(_Driven):
@@ -394,3 +436,9 @@ class SpatialAngleDriver(_Driven):
             rest = cf * ga - sf * gb - 2 * fd * (sf * adot + cf * bdot) - fdd * (sf * a + cf * b) - fd**2 * (cf * a - sf * b)
             out.gamma = -rest[:, None]
         return out
+
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_spatial_angle_driver`)."""
+        from .compiled.elements import compile_spatial_angle_driver
+
+        return compile_spatial_angle_driver(self, layout)

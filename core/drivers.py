@@ -10,6 +10,10 @@ A :class:`TimeFunction` returns the value and its first two time derivatives,
   twice-differentiable cubic spline (:class:`scipy.interpolate.CubicSpline`), whose derivatives
   are exact for the interpolant.
 * :func:`polynomial`, :func:`ramp` and :func:`harmonic` are common closed forms.
+
+The closed forms and tables carry a ``spec`` (kind and parameters) from which the compiled path
+(:mod:`core.compiled.timefunctions`) evaluates the same function in numba; a :func:`motion` of a
+Python callable has none and keeps a model off the compiled integrators (refused by name).
 """
 
 from __future__ import annotations
@@ -18,6 +22,12 @@ from collections.abc import Callable
 
 import numpy as np
 from scipy.interpolate import CubicSpline
+
+from .errors import DataRangeError, InputError
+
+
+class ModelInputTypeError(InputError, TypeError):
+    """A value of the wrong type where a function of time is expected."""
 
 
 class TimeFunction:
@@ -29,10 +39,15 @@ class TimeFunction:
         Value and first and second derivatives.
     label : str
         Used in error messages.
+    spec : tuple, optional
+        ``(kind, *parameters)`` of a closed form or table (``"const"``, ``"poly"``,
+        ``"harmonic"``, ``"spline"``) that the compiled path can evaluate; None for callables.
     """
 
-    def __init__(self, f: Callable[[float], float], fd: Callable[[float], float], fdd: Callable[[float], float], label: str = "f(t)"):
+    def __init__(self, f: Callable[[float], float], fd: Callable[[float], float], fdd: Callable[[float], float],
+                 label: str = "f(t)", spec: tuple | None = None):
         self.f, self.fd, self.fdd, self.label = f, fd, fdd, label
+        self.spec = spec
 
     def __call__(self, t: float) -> tuple[float, float, float]:
         return float(self.f(t)), float(self.fd(t)), float(self.fdd(t))
@@ -90,7 +105,7 @@ class _RangeGuard:
     def __call__(self, tt):
         lo, hi = self.lo, self.hi
         if not self.extrapolate and (tt < lo - 1e-12 * max(1, abs(lo)) or tt > hi + 1e-12 * max(1, abs(hi))):
-            raise ValueError(f"table {self.label!r}: time {tt} outside the tabulated range [{lo}, {hi}]")
+            raise DataRangeError(f"table {self.label!r}: time {tt} outside the tabulated range [{lo}, {hi}]")
         return self.fn(tt)
 
 
@@ -103,7 +118,7 @@ def motion(f: Callable[[float], float], fd: Callable[[float], float] | None = No
     derivatives for tight-tolerance work.
     """
     if not callable(f):
-        raise TypeError(f"motion {label!r}: f must be callable, got {type(f).__name__}")
+        raise ModelInputTypeError(f"motion {label!r}: f must be callable, got {type(f).__name__}")
 
     if fd is None:
         fd = _CentralDifference(f, 1)
@@ -114,14 +129,17 @@ def motion(f: Callable[[float], float], fd: Callable[[float], float] | None = No
 
 def constant(value: float) -> TimeFunction:
     """f(t) = value."""
-    return TimeFunction(_Constant(value), _Constant(0.0), _Constant(0.0), f"{value}")
+    return TimeFunction(_Constant(value), _Constant(0.0), _Constant(0.0), f"{value}", spec=("const", float(value)))
 
 
 def polynomial(coefficients) -> TimeFunction:
     """f(t) = Σ c_k t^k with coefficients in increasing order."""
-    c = np.polynomial.Polynomial(np.asarray(coefficients, float))
+    coef = np.asarray(coefficients, float)
+    if coef.ndim != 1 or len(coef) == 0 or not np.all(np.isfinite(coef)):
+        raise InputError(f"polynomial: coefficients must be a non-empty list of finite numbers, got {coefficients!r}")
+    c = np.polynomial.Polynomial(coef)
     d1, d2 = c.deriv(1), c.deriv(2)
-    return TimeFunction(c, d1, d2, f"poly{list(coefficients)}")
+    return TimeFunction(c, d1, d2, f"poly{list(coefficients)}", spec=("poly", coef.copy()))
 
 
 def ramp(rate: float, start: float = 0.0) -> TimeFunction:
@@ -136,6 +154,7 @@ def harmonic(amplitude: float, omega: float, phase: float = 0.0, offset: float =
         _Harmonic(amplitude, omega, phase, offset, 1),
         _Harmonic(amplitude, omega, phase, offset, 2),
         f"{amplitude}·sin({omega}t+{phase})",
+        spec=("harmonic", float(amplitude), float(omega), float(phase), float(offset)),
     )
 
 
@@ -151,24 +170,25 @@ def tabulated(times, values, label: str = "table", bc_type: str = "not-a-knot",
     label : str
         Names the table in error messages (e.g. the file and column).
     extrapolate : bool
-        If False, evaluating outside ``[times[0], times[-1]]`` raises ValueError.
+        If False, evaluating outside ``[times[0], times[-1]]`` raises :class:`core.errors.DataRangeError`.
     """
     t = np.asarray(times, float)
     y = np.asarray(values, float)
     if t.ndim != 1 or t.shape != y.shape or len(t) < 4:
-        raise ValueError(f"table {label!r}: need ≥ 4 samples of equal length, got {t.shape} and {y.shape}")
+        raise InputError(f"table {label!r}: need ≥ 4 samples of equal length, got {t.shape} and {y.shape}")
     if not np.all(np.isfinite(t)) or not np.all(np.isfinite(y)):
         bad = int(np.flatnonzero(~(np.isfinite(t) & np.isfinite(y)))[0])
-        raise ValueError(f"table {label!r}: non-finite sample at row {bad} (t={t[bad]}, value={y[bad]})")
+        raise InputError(f"table {label!r}: non-finite sample at row {bad} (t={t[bad]}, value={y[bad]})")
     dt = np.diff(t)
     if np.any(dt <= 0):
         k = int(np.flatnonzero(dt <= 0)[0])
-        raise ValueError(f"table {label!r}: times not strictly increasing at row {k + 1} (t={t[k + 1]} after {t[k]})")
+        raise InputError(f"table {label!r}: times not strictly increasing at row {k + 1} (t={t[k + 1]} after {t[k]})")
     cs = CubicSpline(t, y, bc_type=bc_type, extrapolate=True)
     d1, d2 = cs.derivative(1), cs.derivative(2)
     lo, hi = t[0], t[-1]
 
-    return TimeFunction(*(_RangeGuard(fn, lo, hi, label, extrapolate) for fn in (cs, d1, d2)), label)
+    spec = ("spline", np.asarray(cs.x, float).copy(), np.asarray(cs.c, float).copy(), bool(extrapolate), float(lo), float(hi))
+    return TimeFunction(*(_RangeGuard(fn, lo, hi, label, extrapolate) for fn in (cs, d1, d2)), label, spec=spec)
 
 
 def as_time_function(obj, label: str = "f(t)") -> TimeFunction:
@@ -181,4 +201,5 @@ def as_time_function(obj, label: str = "f(t)") -> TimeFunction:
         return motion(obj, label=label)
     if isinstance(obj, tuple) and len(obj) == 2:
         return tabulated(obj[0], obj[1], label=label)
-    raise TypeError(f"{label}: cannot interpret {type(obj).__name__} as a function of time")
+    raise ModelInputTypeError(f"{label}: cannot interpret {type(obj).__name__} as a function of time "
+                              "(give a number, a callable f(t), a (times, values) table or a TimeFunction)")

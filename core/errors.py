@@ -10,10 +10,11 @@ so code written against the built-in types keeps working.
 
 *Numerical failure* during a run (a singular matrix, non-finite values, an iteration that does
 not converge) is not an exception to the caller: the integrator ends the run with status
-``"failed"``, the time and the cause (:mod:`core.simulate`).  Inside a step such failures are
-raised as :class:`NumericalFailure` (or arrive as one of :data:`NUMERICAL_ERRORS` from numpy
-and scipy); every other exception, e.g. a programming error in a user's force element, is *not*
-a numerical failure and propagates with its traceback.
+``"failed"``, the time and the cause (:mod:`core.simulation`).  Inside a step such failures are
+raised as :class:`NumericalFailure` (or arrive as one of :data:`RUN_FAILURES` from numpy and
+scipy, or as a :class:`DataRangeError` when a run goes past the end of a measured input); every
+other exception, e.g. a programming error in a user's force element, is *not* a run failure and
+propagates with its traceback.
 
 =========================== ============================ =============================================
 class                       also a                       raised when
@@ -25,6 +26,7 @@ class                       also a                       raised when
 :class:`RedundantConstraintError` ``ValueError``         dependent constraint equations (lists them)
 :class:`AssemblyError`      ``ValueError``               the configuration cannot be assembled
 :class:`DataFileError`      ``ValueError``               a data file is missing or malformed (names it)
+:class:`DataRangeError`     ``ValueError``               tabulated input evaluated outside its range
 :class:`UnknownNameError`   ``ValueError``               a registry has no entry of that name
 :class:`NameTakenError`     ``ValueError``               a registry name is taken by another object
 :class:`NotCompilable`      ``TypeError``                a model has an element without a compiled kernel
@@ -44,11 +46,12 @@ __all__ = [
     "RedundantConstraintError",
     "AssemblyError",
     "DataFileError",
+    "DataRangeError",
     "UnknownNameError",
     "NameTakenError",
     "NotCompilable",
     "NumericalFailure",
-    "NUMERICAL_ERRORS",
+    "RUN_FAILURES",
 ]
 
 
@@ -85,6 +88,11 @@ class DataFileError(InputError):
     """A data file is missing, truncated or malformed; the message names the file (and line or column)."""
 
 
+class DataRangeError(InputError):
+    """Tabulated input (a measured motion, a force table) evaluated outside its range.  Raised
+    during a run it ends the run as failed, with the time and the table named."""
+
+
 class UnknownNameError(InputError):
     """A registry (integrators, scenes, problems, creep laws, ...) has no entry of that name."""
 
@@ -102,11 +110,13 @@ class NumericalFailure(MbsuiteError, ArithmeticError):
     no convergence).  Integrators turn it into status ``"failed"`` with the time and this message."""
 
 
-#: Exceptions that integrators treat as a numerical failure of the step (status ``"failed"``).
-#: ``LinAlgError`` comes from numpy/scipy factorisations, the arithmetic errors from
-#: ``np.errstate(..., 'raise')`` regions and float arithmetic.  Anything else propagates.
-NUMERICAL_ERRORS: tuple[type[BaseException], ...] = (
+#: Exceptions that end a run as failed (status ``"failed"``, what was computed is kept):
+#: numerical failures (``LinAlgError`` from numpy/scipy factorisations, the arithmetic errors from
+#: ``np.errstate(..., 'raise')`` regions and float arithmetic) and a tabulated input evaluated
+#: past its range.  Anything else propagates.
+RUN_FAILURES: tuple[type[BaseException], ...] = (
     NumericalFailure,
+    DataRangeError,
     np.linalg.LinAlgError,
     FloatingPointError,
     OverflowError,

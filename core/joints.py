@@ -354,6 +354,7 @@ class UserConstraint:
     * ``gamma(t, q, v) -> (rows,)``
 
     The coaster's path-following joint, with the arc length as an extra coordinate, is one.
+    ``compiled(layout)`` may supply a compiled kernel (:mod:`core.compiled`).
 
     Attributes
     ----------
@@ -393,3 +394,15 @@ class UserConstraint:
 
     def gamma(self, t, q, v):  # pragma: no cover - abstract
         raise NotImplementedError(f"user constraint {self.name!r} does not implement gamma")
+
+    def compiled(self, layout):
+        """The compiled form (:class:`core.compiled.CompiledConstraints`) for the fast integrators.
+
+        Override it with a kernel of :mod:`core.compiled` to put the constraint on the compiled
+        path (:class:`core.models.HelixConstraint` is an example); by default the constraint
+        evaluates Python code and the compiled integrators refuse the model naming it.
+        """
+        from .errors import NotCompilable
+
+        raise NotCompilable(f"user constraint {self.name!r} ({type(self).__name__}) has no compiled kernel; "
+                            "give it a compiled() method (see core.compiled) or use the numpy integrators")

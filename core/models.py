@@ -43,6 +43,7 @@ from numpy.typing import NDArray
 from scipy.integrate import solve_ivp
 
 from . import frames
+from .compiled.protocol import OK, WANT_GAMMA, WANT_NU, WANT_PHI, CompiledConstraints, body_slot, constraint_kernel
 from .drivers import ramp
 from .joints import UserConstraint
 from .model import Model, ModelBuilder
@@ -599,6 +600,45 @@ class HelixConstraint(UserConstraint):
         sd = v[self.v_index[6]]
         _, _, ddr = self._curve(s)
         return ddr * sd * sd
+
+    def compiled(self, layout):
+        """Compiled form: :func:`helix_kernel` (the body block and the massless coordinate s)."""
+        b = int(self.q_index[0]) // layout.n_q_body
+        slots = np.array([[body_slot(b, layout.n_bodies), layout.extra_slot(self.coordinates[0], self.name), -1]] * 3,
+                         np.int64)
+        ix = np.array([[b, layout.extra_q_index(self.coordinates[0], self.name),
+                        layout.extra_v_index(self.coordinates[0], self.name)]], np.int64)
+        return CompiledConstraints(kernel=helix_kernel, fd=np.array([[self.R, self.c]]), ix=ix, rows=3, slots=slots,
+                                   names=[self.name], what="helix constraint")
+
+
+@constraint_kernel
+def helix_kernel(t, q, v, r, A, rd, w, lay, fd, ix, row0, flags, phi, G, nu, gam, err):
+    """Compiled :class:`HelixConstraint`: ``Φ = r_b − (R cos s, R sin s, c s)``,
+    ``Φ_q = [I₃ 0 | −r′(s)]`` (body slot, coordinate slot), ``ν = 0``, ``γ = r″(s) ṡ²``
+    (fd: R, c; ix: body, q index and v index of s)."""
+    R, c = fd[0, 0], fd[0, 1]
+    b, qs, vs = ix[0, 0], ix[0, 1], ix[0, 2]
+    s, sd = q[qs], v[vs]
+    cs, sn = np.cos(s), np.sin(s)
+    if flags & WANT_PHI:
+        phi[row0] = r[b, 0] - R * cs
+        phi[row0 + 1] = r[b, 1] - R * sn
+        phi[row0 + 2] = r[b, 2] - c * s
+    for i in range(3):
+        for j in range(6):
+            G[row0 + i, 0, j] = 1.0 if j == i else 0.0
+    G[row0, 1, 0] = R * sn
+    G[row0 + 1, 1, 0] = -R * cs
+    G[row0 + 2, 1, 0] = -c
+    if flags & WANT_NU:
+        for i in range(3):
+            nu[row0 + i] = 0.0
+    if flags & WANT_GAMMA:
+        gam[row0] = -R * cs * sd * sd
+        gam[row0 + 1] = -R * sn * sd * sd
+        gam[row0 + 2] = 0.0
+    return OK
 
 
 def body_on_helix(radius: float = 0.5, pitch: float = 0.2, mass: float = 1.0, bead_radius: float = 0.01,

@@ -15,7 +15,7 @@ and the run metadata (method, tolerances, counters, solve and total wall time). 
 fails (NaN, divergence, an unmet tolerance, a singular matrix) returns with ``status ==
 "failed"``, the message saying where and why, everything computed up to that point and, as its
 last row, the last good state at the time where the run stopped.  Exceptions that are not
-numerical failures (:data:`core.errors.NUMERICAL_ERRORS`) propagate.
+numerical failures (:data:`core.errors.RUN_FAILURES`) propagate.
 
 The integrator protocol itself (step objects, status, counters, dense output, registry) is
 :mod:`core.integrators.base`; this module only drives it.
@@ -28,7 +28,7 @@ import time as _time
 import numpy as np
 
 from .dynamics import accelerations
-from .errors import NUMERICAL_ERRORS, InputError
+from .errors import RUN_FAILURES, InputError
 from .integrators.base import STATUS_FAILED, STATUS_RUNNING, Integrator, get_method
 from .results import SimulationResult
 from .system import ConstrainedSystem
@@ -90,7 +90,7 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
         if k < len(t_eval) and t_eval[k] <= integ.t + 1e-12 * max(1.0, abs(integ.t)):
             try:
                 dense = integ.dense_output()
-            except NUMERICAL_ERRORS as exc:
+            except RUN_FAILURES as exc:
                 integ.status = STATUS_FAILED
                 integ.message = (f"{integ.name} failed at t = {integ.t:.6g} s: dense output could not be "
                                  f"built ({type(exc).__name__}: {exc})")
@@ -103,7 +103,7 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
                 else:
                     try:
                         q, v = dense(tk)
-                    except NUMERICAL_ERRORS as exc:
+                    except RUN_FAILURES as exc:
                         integ.status = STATUS_FAILED
                         integ.message = (f"{integ.name} failed at t = {tk:.6g} s: dense output could not be "
                                          f"evaluated ({type(exc).__name__}: {exc})")
@@ -152,7 +152,7 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
             if lam is None or not (integ.provides_multipliers and len(lam) == system.n_c):
                 try:
                     _, lam = accelerations(system, t, q, v)
-                except NUMERICAL_ERRORS:
+                except RUN_FAILURES:
                     lam = np.full(system.n_c, np.nan)
             L[i] = lam
             for name, val in system.reactions(t, q, lam).items():

@@ -1,7 +1,7 @@
 """Railway wheel-rail geometry, contact search and contact-geometry tables.
 
-Geometry half of the railway domain (Hertz and creep laws live in :mod:`railway.hertz` and the
-creep modules):
+Geometry half of the railway domain (the Hertz theory and the Lankarani-Nikravesh law are
+core's, :mod:`core.contact_laws`; the creep laws live in :mod:`railway.creep`):
 
 * :mod:`railway.profiles` -- S1002 wheel (analytic definition), UIC60 rail (arcs) and measured
   profiles, as smooth curves with first and second derivatives;
@@ -13,7 +13,8 @@ creep modules):
 * :mod:`railway.contact_geometry` -- rigid contact-geometry table and equivalent conicity
   (EN 15302), flange lead with yaw;
 * :mod:`railway.forces` -- Hertz + Lankarani-Nikravesh normal and creep forces of all contacts
-  of a search in one (compiled) call;
+  of a search in one (compiled) call, with the wheel-rail helpers (curvatures by wheel and rail
+  radii, the steady-rolling engagement-velocity floor);
 * :mod:`railway.two_point` -- two-point contact: conical profile, rigid onset, brute-force check;
 * :mod:`railway.quasi_static` -- wheelset position under vertical wheel loads (elastic Hertz);
 * :mod:`railway.scenes` -- scenes for ``mbsuite run``.

@@ -85,7 +85,7 @@ def run_creep_curve(args: argparse.Namespace) -> int:
     from core.results import write_table
 
     from .creep_curve import creep_curve, plot_creep_curve
-    from .hertz import relative_curvatures
+    from .forces import wheel_rail_curvatures
 
     parser = getattr(args, "_creep_parser", None)
     models = args.model or ["polach2000"]
@@ -105,7 +105,7 @@ def run_creep_curve(args: argparse.Namespace) -> int:
         if args.a_mm is not None:
             kw.update(a=args.a_mm * 1e-3, b=args.b_mm * 1e-3)
         else:
-            A, B = relative_curvatures(args.wheel_radius_mm * 1e-3, args.wheel_lateral_radius_mm * 1e-3,
+            A, B = wheel_rail_curvatures(args.wheel_radius_mm * 1e-3, args.wheel_lateral_radius_mm * 1e-3,
                                        args.rail_lateral_radius_mm * 1e-3)
             kw.update(A=float(A[0]), B=float(B[0]))
         params = {"polach2005": dict(k_A=args.k_A, k_S=args.k_S, A=args.A_ratio, B=args.B,

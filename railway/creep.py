@@ -14,9 +14,12 @@ in the contact frame (t, l, n) and oppose the creepage (the convention of the pr
                     Fy = -G c^2 C22 eta - G c^3 C23 phi
                     Mz =  G c^3 C23 eta - G c^4 C33 phi,       c = sqrt(a b)
 
-Models are registered by name (``get_creep_model("polach2000")``) so that a scene switches law by a
-string; a user class deriving from :class:`CreepModel` can be registered with
-:func:`register_creep_model`.
+Models are registered by name in :data:`CREEP_MODELS`, a :class:`core.registry.Registry`
+(``get_creep_model("polach2000")``), so that a scene switches law by a string; a user class
+deriving from :class:`CreepModel` can be registered with :func:`register_creep_model`.  An
+unknown name raises :class:`core.errors.UnknownNameError` listing the registered laws; a name
+taken by another class raises :class:`core.errors.NameTakenError`.  Bad input raises
+:class:`core.errors.InputError` (a ``ValueError``) naming the value.
 
 Kalker coefficients
 -------------------
@@ -66,6 +69,9 @@ from typing import NamedTuple
 import numpy as np
 import pandas as pd
 
+from core.errors import DataFileError, InputError, UnknownNameError
+from core.registry import Registry
+
 __all__ = [
     "CreepForces",
     "CreepModel",
@@ -110,14 +116,14 @@ def kalker_table() -> dict:
     df = pd.read_csv(path, comment=None)
     need = {"branch", "g", "nu", "C11", "C22", "C23", "C33"}
     if not need <= set(df.columns):
-        raise ValueError(f"{path}: missing columns {sorted(need - set(df.columns))}")
+        raise DataFileError(f"{path}: missing columns {sorted(need - set(df.columns))}")
     out = {}
     for branch in ("a/b<=1", "a/b>1"):
         sub = df[df["branch"] == branch]
         gs = np.sort(sub["g"].unique())
         nus = np.sort(sub["nu"].unique())
         if not np.allclose(nus, [0.0, 0.25, 0.5]):
-            raise ValueError(f"{path}: branch {branch} needs nu = 0, 0.25, 0.5; got {nus.tolist()}")
+            raise DataFileError(f"{path}: branch {branch} needs nu = 0, 0.25, 0.5; got {nus.tolist()}")
         entry = {"g": gs}
         for col in ("C11", "C22", "C23", "C33"):
             piv = sub.pivot(index="g", columns="nu", values=col).loc[gs, nus]
@@ -182,10 +188,10 @@ def kalker_coefficients(a_over_b, nu, join: str = "scaled"):
     nu = nu.astype(float).copy()
     if np.any(~(r > 0)) or np.any(~np.isfinite(r)):
         i = int(np.flatnonzero(~(r > 0) | ~np.isfinite(r))[0])
-        raise ValueError(f"a_over_b must be finite and > 0, got {float(r[i])!r} at index {i}")
+        raise InputError(f"a_over_b must be finite and > 0, got {float(r[i])!r} at index {i}")
     _check_nu(nu)
     if join not in ("scaled", "raw"):
-        raise ValueError(f"join must be 'scaled' or 'raw', got {join!r}")
+        raise InputError(f"join must be 'scaled' or 'raw', got {join!r}")
     tab = kalker_table()
     out = np.empty((4, r.size))
     for branch, mask, g_of, asym in (("a/b<=1", r <= 1.0, lambda x: x, _asymptote_small_a),
@@ -240,7 +246,7 @@ def _check_nu(nu):
     bad = ~((nu >= 0.0) & (nu <= 0.5))
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"Poisson ratio nu must lie in [0, 0.5], got {float(nu[i])!r} at index {i}")
+        raise InputError(f"Poisson ratio nu must lie in [0, 0.5], got {float(nu[i])!r} at index {i}")
 
 
 def _validate(xi, eta, phi, normal_force, a, b, G, nu, mu):
@@ -250,32 +256,32 @@ def _validate(xi, eta, phi, normal_force, a, b, G, nu, mu):
         arrs = [np.array(x, dtype=float) for x in np.broadcast_arrays(*arrs)]
     except ValueError as exc:
         shapes = {n: np.shape(x) for n, x in zip(names, arrs)}
-        raise ValueError(f"creep model inputs do not broadcast: {shapes}") from exc
+        raise InputError(f"creep model inputs do not broadcast: {shapes}") from exc
     for name, x in zip(names, arrs):
         if x.ndim != 1:
-            raise ValueError(f"{name} must be a scalar or 1-D array, got shape {x.shape}")
+            raise InputError(f"{name} must be a scalar or 1-D array, got shape {x.shape}")
         bad = ~np.isfinite(x)
         if np.any(bad):
             i = int(np.flatnonzero(bad)[0])
-            raise ValueError(f"{name} must be finite, got {float(x[i])!r} at index {i}")
+            raise InputError(f"{name} must be finite, got {float(x[i])!r} at index {i}")
     xi, eta, phi, N, a, b, G, nu, mu = arrs
     for name, x in (("normal_force", N), ("a", a), ("b", b)):
         if np.any(x < 0):
             i = int(np.flatnonzero(x < 0)[0])
-            raise ValueError(f"{name} must be >= 0, got {float(x[i])!r} at index {i}")
+            raise InputError(f"{name} must be >= 0, got {float(x[i])!r} at index {i}")
     loaded = N > 0
     flat = loaded & ((a <= 0) | (b <= 0))
     if np.any(flat):
         i = int(np.flatnonzero(flat)[0])
-        raise ValueError(f"loaded contact {i} (N={float(N[i])!r} N) needs semi-axes a, b > 0; "
+        raise InputError(f"loaded contact {i} (N={float(N[i])!r} N) needs semi-axes a, b > 0; "
                          f"got a={float(a[i])!r}, b={float(b[i])!r} m")
     if np.any(G <= 0):
         i = int(np.flatnonzero(G <= 0)[0])
-        raise ValueError(f"shear modulus G must be > 0, got {float(G[i])!r} Pa at index {i}")
+        raise InputError(f"shear modulus G must be > 0, got {float(G[i])!r} Pa at index {i}")
     _check_nu(nu)
     if np.any(mu <= 0):
         i = int(np.flatnonzero(mu <= 0)[0])
-        raise ValueError(f"friction coefficient mu must be > 0, got {float(mu[i])!r} at index {i}")
+        raise InputError(f"friction coefficient mu must be > 0, got {float(mu[i])!r} at index {i}")
     return xi, eta, phi, N, a, b, G, nu, mu
 
 
@@ -315,8 +321,9 @@ class CreepModel:
 
         Raises
         ------
-        ValueError
-            NaN/inf input, negative load or semi-axis, G <= 0, nu outside [0, 0.5], mu <= 0.
+        core.errors.InputError
+            NaN/inf input, negative load or semi-axis, G <= 0, nu outside [0, 0.5], mu <= 0
+            (a ``ValueError``; names the value and its index).
         """
         xi, eta, phi, N, a, b, G, nu, mu = _validate(xi, eta, phi, normal_force, a, b, G, nu, mu)
         Fx = np.zeros_like(xi)
@@ -336,23 +343,40 @@ class CreepModel:
         return f"{type(self).__name__}({params})"
 
 
-CREEP_MODELS: dict[str, type[CreepModel]] = {}
+def _check_creep_model(obj) -> None:
+    if not (isinstance(obj, type) and issubclass(obj, CreepModel)):
+        raise TypeError(f"the creep-model registry takes CreepModel subclasses, got {obj!r}")
 
 
-def register_creep_model(name: str, cls: type[CreepModel] | None = None):
+#: Name -> creep law class (a :class:`core.registry.Registry`: one rule for a taken name, and an
+#: unknown name raises :class:`core.errors.UnknownNameError` listing the registered laws).
+CREEP_MODELS: Registry[type[CreepModel]] = Registry("creep model", _check_creep_model)
+
+
+def register_creep_model(name: str, cls: type[CreepModel] | None = None, *, replace: bool = False):
     """Register a creep model class under ``name`` (usable as a decorator).
+
+    The class's ``name`` attribute is set to ``name``.  Registering the same class again is a
+    no-op; remove a law with ``CREEP_MODELS.unregister(name)``.
+
+    Parameters
+    ----------
+    name : str
+        Registry name (lower case with underscores, as looked up by :func:`get_creep_model`).
+    cls : CreepModel subclass, optional
+        Without it, a decorator is returned.
+    replace : bool
+        Replace a different class registered under ``name``.
 
     Raises
     ------
-    ValueError
-        If ``name`` is taken by another class or ``cls`` is not a CreepModel subclass.
+    core.errors.NameTakenError
+        If ``name`` is taken by another class (and ``replace`` is False); names both.
+    TypeError
+        If ``cls`` is not a CreepModel subclass.
     """
     def deco(c):
-        if not (isinstance(c, type) and issubclass(c, CreepModel)):
-            raise ValueError(f"creep model {name!r} must be a CreepModel subclass, got {c!r}")
-        if name in CREEP_MODELS and CREEP_MODELS[name] is not c:
-            raise ValueError(f"creep model name {name!r} already registered to {float(CREEP_MODELS[name])!r}")
-        CREEP_MODELS[name] = c
+        CREEP_MODELS.register(name, c, replace=replace)
         c.name = name
         return c
 
@@ -365,24 +389,36 @@ def get_creep_model(model, **params) -> CreepModel:
     Parameters
     ----------
     model : str, CreepModel subclass or CreepModel
-        e.g. ``"kalker_linear"``, ``"polach2000"``, ``"polach2005"``, ``"shen_hedrick_elkins"``,
-        ``"fastsim"``.
+        A name of :data:`CREEP_MODELS` (``"kalker_linear"``, ``"polach2000"``, ``"polach2005"``,
+        ``"shen_hedrick_elkins"``, ``"fastsim"``, user laws) or an alias (``"kalker"``,
+        ``"polach"``, ``"SHE"``, ...); case, surrounding blanks and ``-``/``_`` do not matter.
     **params
         Constructor parameters of the model (not allowed with an instance).
+
+    Raises
+    ------
+    core.errors.UnknownNameError
+        An unknown name; the message lists the registered laws.
+    core.errors.InputError
+        Parameters given with an instance, or ``model`` of another type.
     """
     if isinstance(model, CreepModel):
         if params:
-            raise ValueError(f"parameters {sorted(params)} given with a model instance {model!r}")
+            raise InputError(f"parameters {sorted(params)} given with a model instance {model!r}")
         return model
     if isinstance(model, type) and issubclass(model, CreepModel):
         return model(**params)
     if isinstance(model, str):
         key = model.strip().lower().replace("-", "_")
         key = _ALIASES.get(key, key)
-        if key not in CREEP_MODELS:
-            raise ValueError(f"unknown creep model {model!r}; known: {sorted(CREEP_MODELS)}")
-        return CREEP_MODELS[key](**params)
-    raise ValueError(f"creep model must be a name, a CreepModel class or instance, got {model!r}")
+        try:
+            cls = CREEP_MODELS[key]
+        except UnknownNameError as exc:  # the registry's message lists the registered laws
+            given = f" (given as {model!r})" if key != model else ""
+            aliases = ", ".join(f"{a} -> {k}" for a, k in _ALIASES.items())
+            raise UnknownNameError(f"{exc}{given}; aliases: {aliases}") from None
+        return cls(**params)
+    raise InputError(f"creep model must be a name, a CreepModel class or instance, got {model!r}")
 
 
 def creep_forces(model, xi, eta, phi, normal_force, a, b, G, nu, mu, **params) -> CreepForces:
@@ -565,13 +601,13 @@ class Polach2005(CreepModel):
     def __init__(self, k_A: float = 1.0, k_S: float = 1.0, A: float = 1.0, B: float = 0.0,
                  speed: float = 20.0, join: str = "scaled"):
         if not (0.0 < k_S <= k_A <= 1.0):
-            raise ValueError(f"Polach 2005 needs 0 < k_S <= k_A <= 1, got k_A={k_A!r}, k_S={k_S!r}")
+            raise InputError(f"Polach 2005 needs 0 < k_S <= k_A <= 1, got k_A={k_A!r}, k_S={k_S!r}")
         if not (0.0 < A <= 1.0):
-            raise ValueError(f"Polach 2005 friction ratio A must lie in (0, 1], got {A!r}")
+            raise InputError(f"Polach 2005 friction ratio A must lie in (0, 1], got {A!r}")
         if not (B >= 0.0):
-            raise ValueError(f"Polach 2005 friction decay B must be >= 0 s/m, got {B!r}")
+            raise InputError(f"Polach 2005 friction decay B must be >= 0 s/m, got {B!r}")
         if not (speed > 0.0):
-            raise ValueError(f"Polach 2005 speed must be > 0 m/s, got {speed!r}")
+            raise InputError(f"Polach 2005 speed must be > 0 m/s, got {speed!r}")
         self.k_A, self.k_S, self.A, self.B, self.speed, self.join = k_A, k_S, A, B, speed, join
 
     def friction(self, mu0, xi, eta):
@@ -618,7 +654,7 @@ class Fastsim(CreepModel):
 
     def __init__(self, n_x: int = 40, n_y: int = 40, join: str = "scaled"):
         if int(n_x) < 2 or int(n_y) < 2:
-            raise ValueError(f"FASTSIM grid needs n_x, n_y >= 2, got n_x={n_x!r}, n_y={n_y!r}")
+            raise InputError(f"FASTSIM grid needs n_x, n_y >= 2, got n_x={n_x!r}, n_y={n_y!r}")
         self.n_x, self.n_y, self.join = int(n_x), int(n_y), join
 
     def _forces(self, xi, eta, phi, N, a, b, G, nu, mu):

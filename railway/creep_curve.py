@@ -2,7 +2,7 @@
 
 The swept creepage (xi, eta or phi) takes the given values while the other two are held fixed;
 the contact is given by its normal load and semi-axes, or by the curvatures and elastic constants
-(the semi-axes then follow from Hertz, :func:`railway.hertz.hertz_from_load`).
+(the semi-axes then follow from Hertz, :func:`core.contact_laws.hertz_from_load`).
 
 References
 ----------
@@ -14,8 +14,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from core.contact_laws import hertz_from_load
+
 from .creep import get_creep_model
-from .hertz import hertz_from_load
 
 __all__ = ["creep_curve", "plot_creep_curve", "semi_axes_from_curvatures"]
 

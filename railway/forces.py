@@ -5,26 +5,41 @@ penetration delta, the forces on the wheel are::
 
     A = (k_wheel_rolling + k_rail_rolling)/2,  B = (k_wheel_lateral + k_rail_lateral)/2
     Hertz (Johnson 1985, sect. 4.2):  N_e = K_h(A, B) delta^(3/2),  semi-axes a (rolling), b
-    Lankarani-Nikravesh (1990):        N = N_e [1 + 3 (1 - c_e^2)/4 * delta_dot / v0],  N >= 0
+    Lankarani-Nikravesh (1990, Eq. 17):  N = N_e [1 + 3 (1 - c_e^2)/4 * delta_dot / v0],  N >= 0
     creepages (Kalker 1990, ch. 1):    xi = (v_w . t)/V,  eta = (v_w . l)/V,  phi = (omega . n)/V
-    creep law (Kalker linear or Polach 2000):  Fx, Fy, Mz in the contact frame (t, l, n)
+    creep law (any of railway.creep):  Fx, Fy, Mz in the contact frame (t, l, n)
     force on the wheel (global):       F = N n + Fx t + Fy l,   moment Mz n
 
 with v_w = v_ws + omega x (p - r_ws) the velocity of the wheel material point at the contact
 (rail fixed), delta_dot = -v_w . n, t the wheelset's forward axis projected onto the tangent
-plane, l = n x t and V = |v_ws . t| the rolling speed.  The damping reference velocity v0 is the
-floor of :func:`railway.hertz.lankarani_nikravesh_force` (steady rolling has no impact velocity;
-see the trap documented there).
+plane, l = n x t and V = |v_ws . t| the rolling speed.  Body 1 of :mod:`core.contact_laws` is the
+wheel, body 2 the rail, x the rolling and y the lateral direction.
+
+The Hertz theory and the Lankarani-Nikravesh law are defined once, in :mod:`core.contact_laws`
+(Eqs. H1-H7 and N1 there).  This module adds only what is specific to rolling wheels:
+
+* :func:`wheel_rail_curvatures` -- Eq. (H1) with wheel and rail radii by name;
+* :func:`lankarani_nikravesh_force` -- the law N1 with chi = 3 (1 - c_e^2)/4 and the
+  *steady-rolling engagement-velocity floor* v0: the law was derived for impacts, where
+  delta_dot^- is the approach velocity at first touch, but a rolling wheel has no impact and
+  delta_dot^- is undefined (~0, which would make the damping singular).  We use the engagement
+  velocity when the caller knows it and never less than the floor ``approach_velocity_floor``
+  (default 0.1 m/s); :class:`ContactForces` uses the floor alone.
 
 Two implementations, tested against each other:
 
 * the reference (``compiled=False``) calls the project's validated modules
-  (:func:`railway.hertz.hertz_from_penetration`, :func:`railway.hertz.lankarani_nikravesh_force`,
-  :func:`railway.creepage.creepages`, :mod:`railway.creep` models) on the loaded contacts;
+  (:func:`core.contact_laws.hertz_from_penetration`, :func:`lankarani_nikravesh_force`,
+  :func:`railway.creepage.creepages`, the :mod:`railway.creep` laws) on the loaded contacts;
+  it accepts every creep law of :data:`railway.creep.CREEP_MODELS` (and user laws);
 * the compiled kernel (numba) evaluates the same equations per contact in one loop, with the
   Hertz coefficients (ellipse ratio, m, n, K(e)) and Kalker's C11, C22, C23, C33 tabulated once
   against t = ln(B/A) on a uniform grid of 4001 nodes (linear interpolation; relative error
-  below 1e-4 against the exact bisection and table interpolation, see the tests).
+  below 1e-4 against the exact bisection and table interpolation, see the tests).  Its normal
+  law is Eq. (N1) of :mod:`core.contact_laws` written for numba (tested to agree with
+  :func:`core.contact_laws.hysteresis_force`).  It implements only the creep laws
+  ``kalker_linear`` and ``polach2000`` (with the default ``join="scaled"``); every other law
+  runs on the reference path (``compiled="auto"``) -- a law is never replaced by another.
 
 Conformal contacts (the concave S1002 flange root on the gauge corner) are not Hertzian (B <= 0);
 both implementations clip the curvature ratio B/A to [1/rho_max, rho_max] (rho_max = 1e3) and so
@@ -34,31 +49,161 @@ model.
 References
 ----------
 Johnson, K. L. (1985). Contact Mechanics, ch. 4.  Lankarani, H. M. and Nikravesh, P. E. (1990).
-J. Mech. Design 112:369-376.  Kalker, J. J. (1990). Three-dimensional elastic bodies in rolling
-contact, Table E.3.  Polach, O. (2000). VSD 33 Suppl.:728-739.
+J. Mech. Design 112:369-376, Eq. 17.  Kalker, J. J. (1990). Three-dimensional elastic bodies in
+rolling contact, Table E.3.  Polach, O. (2000). VSD 33 Suppl.:728-739.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .creep import get_creep_model, kalker_coefficients
-from .hertz import effective_modulus, ellipse_ratio, hertz_from_penetration, lankarani_nikravesh_force
+from core.contact_laws import (
+    HYSTERESIS_LAWS,
+    effective_modulus,
+    ellipse_ratio,
+    hertz_from_penetration,
+    hysteresis_force,
+    relative_curvatures,
+)
+from core.errors import InputError
 
-__all__ = ["ContactForces", "FORCE_KEYS"]
+from .creep import CreepModel, KalkerLinear, Polach2000, get_creep_model, kalker_coefficients
+
+__all__ = ["ContactForces", "FORCE_KEYS", "lankarani_nikravesh_force", "wheel_rail_curvatures"]
 
 #: keys of the dictionary returned by :meth:`ContactForces.__call__`, arrays (n_wheels, 2)
 FORCE_KEYS = ("N", "Fx", "Fy", "Mz", "xi", "eta", "phi", "a", "b", "delta_dot")
-_MODELS = {"kalker_linear": 0, "polach2000": 1}
 _RHO_MAX = 1e3
+
+
+def _kernel_code(law: CreepModel) -> int | None:
+    """Code of ``law`` in the compiled kernel (0 Kalker linear, 1 Polach 2000) or None.
+
+    Only the exact classes with the tables the kernel is built from (``join="scaled"``) qualify;
+    subclasses and other joins run on the reference path.
+    """
+    if getattr(law, "join", None) != "scaled":
+        return None
+    return {KalkerLinear: 0, Polach2000: 1}.get(type(law))
+
+
+def wheel_rail_curvatures(R_wheel_rolling, R_wheel_lateral, R_rail_lateral, R_rail_rolling=np.inf):
+    """Relative curvatures A (rolling) and B (lateral) of a wheel on a rail [1/m].
+
+    Eq. (H1) of :mod:`core.contact_laws` with body 1 = wheel, body 2 = rail, x = rolling::
+
+        A = (1/R_wheel_rolling + 1/R_rail_rolling)/2,  B = (1/R_wheel_lateral + 1/R_rail_lateral)/2
+
+    Parameters
+    ----------
+    R_wheel_rolling : float or (n,) array_like
+        Wheel rolling radius [m] (> 0).
+    R_wheel_lateral : float or (n,) array_like
+        Wheel profile radius in the lateral plane [m]; negative where the profile is concave
+        (flange root), ``inf`` for a conical tread.
+    R_rail_lateral : float or (n,) array_like
+        Rail head profile radius [m].
+    R_rail_rolling : float or (n,) array_like, optional
+        Rail radius along the track (``inf`` for straight rail, finite for a roller rig).
+
+    Returns
+    -------
+    A, B : (n,) ndarray
+        Relative curvatures [1/m].
+
+    Raises
+    ------
+    core.errors.InputError
+        A zero radius or a non-Hertzian combination, naming the contact index and the radii
+        (R1 = wheel, R2 = rail).
+    """
+    try:
+        return relative_curvatures(R_wheel_rolling, R_wheel_lateral, R_rail_rolling, R_rail_lateral)
+    except InputError as exc:
+        raise InputError(f"wheel on rail (R1 = wheel, R2 = rail; x rolling, y lateral): {exc}") from None
+
+
+def lankarani_nikravesh_force(penetration, penetration_rate, stiffness, restitution,
+                              approach_velocity=None, approach_velocity_floor=0.1):
+    """Lankarani-Nikravesh normal force of a rolling wheel, with the engagement-velocity floor [N].
+
+    Eq. (N1) of :mod:`core.contact_laws` with p = 3/2 and chi = 3 (1 - c_e^2)/4
+    (``HYSTERESIS_LAWS["lankarani-nikravesh"]``)::
+
+        F_N = max(0, K_h delta^(3/2) [1 + 3 (1 - c_e^2)/4 * delta_dot / v0])  for delta > 0, else 0
+        v0  = max(|approach_velocity|, approach_velocity_floor)
+
+    Choice for steady rolling (documented trap, see the module docstring): with
+    ``approach_velocity=None`` the floor alone is used, so the law acts as a Hertz spring with the
+    linear-in-rate damper c(delta) = 3 (1 - c_e^2) K_h delta^(3/2) / (4 v0).  The force is clipped
+    at zero because the law would otherwise pull the bodies together in fast separation
+    (delta_dot < -4 v0/(3(1 - c_e^2))).
+
+    Parameters
+    ----------
+    penetration : float or (n,) array_like
+        delta [m].
+    penetration_rate : float or (n,) array_like
+        d delta/dt [m/s] (> 0 approaching).
+    stiffness : float or (n,) array_like
+        K_h [N/m^1.5] (from :func:`core.contact_laws.hertz_from_load`), >= 0.
+    restitution : float or (n,) array_like
+        Coefficient of restitution c_e in [0, 1].
+    approach_velocity : float, (n,) array_like or None
+        Velocity at engagement [m/s] (e.g. stored by a contact element when a flange contact is
+        first detected); None in steady rolling.
+    approach_velocity_floor : float
+        Lower bound of v0 [m/s] (> 0).
+
+    Returns
+    -------
+    (n,) ndarray
+        Normal force [N].
+
+    Raises
+    ------
+    core.errors.InputError
+        NaN input, c_e outside [0, 1], K_h < 0 or a floor <= 0 (names the value).
+
+    References
+    ----------
+    Lankarani & Nikravesh (1990), J. Mech. Design 112: 369-376, Eq. 17.
+    """
+    if not approach_velocity_floor > 0:
+        raise InputError(f"approach_velocity_floor must be > 0, got {approach_velocity_floor!r}")
+    chi = HYSTERESIS_LAWS["lankarani-nikravesh"].factor(restitution)
+    v0 = np.full(1, float(approach_velocity_floor))
+    if approach_velocity is not None:
+        va = np.asarray(approach_velocity, dtype=float)
+        if np.any(np.isnan(va)):
+            raise InputError(f"approach_velocity contains NaN: {va.tolist()!r}")
+        v0 = np.maximum(np.abs(np.atleast_1d(va)), v0)
+    return hysteresis_force(np.atleast_1d(penetration), np.atleast_1d(penetration_rate),
+                            np.atleast_1d(stiffness), chi, v0, 1.5).force
 
 
 def _define_kernel():
     import numba
 
     @numba.njit(cache=True)
+    def normal_law(Kh, d, dd, chi, v0):
+        """Eq. (N1) of :mod:`core.contact_laws` with p = 3/2, for numba (one contact).
+
+        F = max(0, K_h d^(3/2) (1 + chi dd / v0)) for d > 0, else 0; the one definition is
+        :func:`core.contact_laws.hysteresis_force` (tested to agree).
+        """
+        if not (d > 0.0):
+            return 0.0
+        F = Kh * d**1.5 * (1.0 + chi * dd / v0)
+        return F if F > 0.0 else 0.0
+
+    @numba.njit(cache=True)
     def kernel(pen, valid, kwr, kwl, krr, krl, P, Nrm, ws_of, rws, vws, wws, fwd,
-               t0, dt, tab, ksum, G, mu, ce, v0, model, out, Fg, Mg):
+               t0, dt, tab, ksum, G, mu, chi, v0, model, out, Fg, Mg):
+        """All contacts in one loop: Hertz (Eqs. H1-H6 of :mod:`core.contact_laws`, coefficients
+        from ``tab``), the normal law N1 (:func:`normal_law`), creepages and the creep law
+        ``model`` (0 Kalker linear, 1 Polach 2000, as :mod:`railway.creep`).  See the module
+        docstring; the definitions are those modules, this is their compiled copy."""
         nt = tab.shape[1]
         vmin = np.inf
         for i in range(pen.shape[0]):
@@ -124,9 +269,7 @@ def _define_kernel():
             if V < 1e-3:
                 continue
             dd = -(vx * n0 + vy * n1 + vz * n2)
-            N = Ne * (1.0 + 0.75 * (1.0 - ce * ce) * dd / v0)
-            if N < 0.0:
-                N = 0.0
+            N = normal_law(Kh, d, dd, chi, v0)
             xi = (vx * tx + vy * ty + vz * tz) / V
             eta = (vx * lx + vy * ly + vz * lz) / V
             phi = (wx * n0 + wy * n1 + wz * n2) / V
@@ -184,13 +327,14 @@ def _define_kernel():
             Mg[i, 2] = Mz * n2
         return vmin
 
-    return kernel
+    return kernel, normal_law
 
 
 _KERNEL = None
 
 
-def _kernel():
+def _kernels():
+    """(kernel, normal_law) compiled once, or None without numba."""
     global _KERNEL
     if _KERNEL is None:
         try:
@@ -198,6 +342,17 @@ def _kernel():
         except ImportError:  # pragma: no cover - numba missing
             _KERNEL = False
     return _KERNEL or None
+
+
+def _kernel():
+    k = _kernels()
+    return None if k is None else k[0]
+
+
+def _compiled_normal_law():
+    """The kernel's normal law ``normal_law(Kh, d, dd, chi, v0)`` (numba), or None (for tests)."""
+    k = _kernels()
+    return None if k is None else k[1]
 
 
 class ContactForces:
@@ -212,14 +367,44 @@ class ContactForces:
     nu : float
         Poisson ratio, default 0.28; G = E / (2 (1 + nu)).
     mu : float
-        Friction coefficient (> 0).
-    creep_model : {"polach2000", "kalker_linear"}
+        Friction coefficient (> 0); for Polach 2005 the static value mu0.
+    creep_model : str, CreepModel subclass or CreepModel
+        Any creep law of :data:`railway.creep.CREEP_MODELS` by name or alias (``"kalker_linear"``,
+        ``"shen_hedrick_elkins"``, ``"polach2000"``, ``"polach2005"``, ``"fastsim"``, or one
+        registered by the user), a :class:`railway.creep.CreepModel` class or an instance.
     restitution : float
         Coefficient of restitution c_e of the Lankarani-Nikravesh damping, in [0, 1].
     approach_velocity_floor : float
-        Damping reference velocity v0 (m/s), see :func:`railway.hertz.lankarani_nikravesh_force`.
+        Damping reference velocity v0 (m/s), see :func:`lankarani_nikravesh_force`.
     compiled : {"auto", True, False}
-        Use the numba kernel ("auto": when numba is installed) or the reference modules.
+        ``"auto"``: the numba kernel when numba is installed *and* the kernel implements the creep
+        law (``kalker_linear`` or ``polach2000`` with ``join="scaled"``), else the numpy reference
+        path -- every other law (Shen-Hedrick-Elkins, Polach 2005, FASTSIM, user laws, another
+        join) runs there, never replaced by a compiled one.  ``True``: the kernel or an error;
+        ``False``: the reference path.  :attr:`compiled` tells which path is used.
+    creep_params : dict, optional
+        Constructor parameters of the creep law given by name or class (e.g. Polach 2005's
+        ``k_A, k_S, A, B, speed``).  Note that Polach 2005 evaluates its slip velocity with its
+        own ``speed`` parameter, not with the rolling speed of the wheelsets.
+
+    Attributes
+    ----------
+    creep_law : CreepModel
+        The creep law instance used on both paths.
+    creep_model : str
+        Its registry name.
+    compiled : bool
+        True when the numba kernel is used.
+
+    Raises
+    ------
+    core.errors.InputError
+        A parameter out of range (named), or ``compiled=True`` with a creep law the kernel does
+        not implement.
+    core.errors.UnknownNameError
+        An unknown creep-law name (lists the registered laws).
+    ImportError
+        ``compiled=True`` without numba.
 
     References
     ----------
@@ -227,28 +412,34 @@ class ContactForces:
     """
 
     def __init__(self, E=2.1e11, nu=0.28, mu=0.3, creep_model="polach2000", restitution=0.9,
-                 approach_velocity_floor=0.1, compiled="auto"):
+                 approach_velocity_floor=0.1, compiled="auto", creep_params=None):
         for name, val, ok in (("E", E, E > 0), ("nu", nu, 0.0 <= nu <= 0.5), ("mu", mu, mu > 0),
                               ("restitution", restitution, 0.0 <= restitution <= 1.0),
                               ("approach_velocity_floor", approach_velocity_floor,
                                approach_velocity_floor > 0)):
             if not (np.isfinite(val) and ok):
-                raise ValueError(f"ContactForces: {name} = {val!r} is out of range")
-        key = str(creep_model).lower()
-        if key not in _MODELS:
-            raise ValueError(f"ContactForces: creep_model {creep_model!r} not in {sorted(_MODELS)}")
+                raise InputError(f"ContactForces: {name} = {val!r} is out of range")
         if compiled not in ("auto", True, False):
-            raise ValueError(f"compiled must be 'auto', True or False, got {compiled!r}")
+            raise InputError(f"compiled must be 'auto', True or False, got {compiled!r}")
+        self.creep_law = get_creep_model(creep_model, **(creep_params or {}))
+        self.creep_model = self.creep_law.name
+        code = _kernel_code(self.creep_law)
+        if compiled is True and code is None:
+            raise InputError(f"ContactForces: compiled=True, but the numba kernel implements only the "
+                             f"creep laws kalker_linear and polach2000 (join='scaled'), not "
+                             f"{self.creep_law!r}; use compiled='auto' or False (numpy reference path)")
         self.E, self.nu, self.mu = float(E), float(nu), float(mu)
         self.G = self.E / (2.0 * (1.0 + self.nu))
-        self.creep_model = key
         self.restitution = float(restitution)
+        self._chi = float(HYSTERESIS_LAWS["lankarani-nikravesh"].factor(self.restitution))
         self.v0 = float(approach_velocity_floor)
         self._ksum = 1.0 / (np.pi * float(np.ravel(effective_modulus(E, nu, E, nu))[0]))
-        self._kernel = _kernel() if compiled else None
+        self._kernel = _kernel() if (compiled and code is not None) else None
+        self._model_code = code
         self._ws_of = None
         if compiled is True and self._kernel is None:
             raise ImportError("compiled=True needs numba")
+        self.compiled = self._kernel is not None
         if self._kernel is not None:
             self._build_table()
 
@@ -291,7 +482,7 @@ class ContactForces:
 
         Raises
         ------
-        ValueError
+        core.errors.InputError
             Non-finite velocities, or a rolling speed below 1e-3 m/s at a loaded contact
             (creepages undefined).
         """
@@ -304,7 +495,7 @@ class ContactForces:
         for name, arr in (("v_ws", v_ws), ("omega_ws", omega_ws)):
             if not np.all(np.isfinite(arr)):
                 idx = np.argwhere(~np.isfinite(arr))[0]
-                raise ValueError(f"ContactForces: {name}{idx.tolist()} = {float(arr[tuple(idx)])!r} is not finite")
+                raise InputError(f"ContactForces: {name}{idx.tolist()} = {float(arr[tuple(idx)])!r} is not finite")
         fwd = np.ascontiguousarray(A_ws[:, :, 0])
         if self._kernel is not None:
             return self._compiled(res, r_ws, fwd, v_ws, omega_ws)
@@ -323,10 +514,10 @@ class ContactForces:
                             res.k_rail_rolling.reshape(M), res.k_rail_lateral.reshape(M),
                             res.point_wheel.reshape(M, 3), res.normal.reshape(M, 3), self._ws_of,
                             r_ws, v_ws, omega_ws, fwd, self._t0, self._dt, self._tab, self._ksum,
-                            self.G, self.mu, self.restitution, self.v0,
-                            _MODELS[self.creep_model], out, Fg, Mg)
+                            self.G, self.mu, self._chi, self.v0,
+                            self._model_code, out, Fg, Mg)
         if vmin < 1e-3:
-            raise ValueError(f"ContactForces: rolling speed {vmin!r} m/s at a loaded contact is "
+            raise InputError(f"ContactForces: rolling speed {vmin!r} m/s at a loaded contact is "
                              "below 1e-3 m/s: creepages undefined")
         out = out.reshape(shp + (10,))
         d = {k: out[..., i] for i, k in enumerate(FORCE_KEYS)}
@@ -359,7 +550,7 @@ class ContactForces:
             dd = -np.einsum("ij,ij->i", vw, n)
             N = lankarani_nikravesh_force(pen[on], dd, h.stiffness, self.restitution,
                                           approach_velocity_floor=self.v0)
-            f = get_creep_model(self.creep_model)(xi, eta, phi, N, h.a, h.b, self.G, self.nu, self.mu)
+            f = self.creep_law(xi, eta, phi, N, h.a, h.b, self.G, self.nu, self.mu)
             t = fwd[iw] - np.einsum("ij,ij->i", fwd[iw], n)[:, None] * n
             t /= np.linalg.norm(t, axis=1)[:, None]
             l = np.cross(n, t)

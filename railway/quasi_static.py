@@ -6,7 +6,7 @@ vertical load Q of each wheel (creep forces neglected, the lateral force is what
 must supply to hold the shift)::
 
     sum_c N_c(z, phi) n_c . e_up = Q     for the left and for the right wheel
-    N_c = K_h(A_c, B_c) delta_c^(3/2)    (Hertz, delta_c = -gap_c > 0)
+    N_c = K_h(A_c, B_c) delta_c^(3/2)    (Hertz, delta_c = -gap_c > 0; Eq. H6 of core.contact_laws)
 
 solved by Newton's method with a forward-difference 2x2 Jacobian per shift, vectorised over
 shifts (one contact search for the base poses and the two perturbed poses of all shifts).
@@ -25,9 +25,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from core.contact_laws import hertz_from_penetration
+
 from .contact_geometry import rigid_contact
 from .contact_search import FLANGE, ContactSearch, wheelset_pose
-from .hertz import hertz_from_penetration
 from .profiles import WheelProfile
 from .track import RailMounting, Track
 

@@ -151,6 +151,12 @@ class AppliedForceKind(ForceKind):
         _, F = self._F(bs, t)
         return {f"F{a} [N]": F[:, k] for k, a in enumerate("xyz"[: bs.space.dim])}
 
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_applied_forces`)."""
+        from ..compiled.elements import compile_applied_forces
+
+        return compile_applied_forces(self, layout)
+
 
 @dataclass(frozen=True)
 class AppliedTorque(ForceElement):
@@ -238,3 +244,9 @@ class AppliedTorqueKind(ForceKind):
         if bs.space.dim == 2:
             return {"Mz [N m]": Tc[:, 0]}
         return {f"M{a} [N m]": Tc[:, k] for k, a in enumerate("xyz")}
+
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_applied_torques`)."""
+        from ..compiled.elements import compile_applied_torques
+
+        return compile_applied_torques(self, layout)

@@ -198,6 +198,11 @@ class SpringDamperKind(ForceKind):
         f = self.k * (L - self.L0) + self.c * Ld + self._fa(t)
         return {"length [m]": L, "force [N]": f}
 
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_spring_dampers`)."""
+        from ..compiled.elements import compile_spring_dampers
+
+        return compile_spring_dampers(self, layout)
 
 
 # --------------------------------------------------------------------------------------------
@@ -289,6 +294,12 @@ class PointSpringKind(ForceKind):
     def outputs(self, bs, t):
         d, F = self._F(bs)
         return {"elongation [m]": np.linalg.norm(d, axis=1), "force [N]": np.linalg.norm(F, axis=1)}
+
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_point_springs`)."""
+        from ..compiled.elements import compile_point_springs
+
+        return compile_point_springs(self, layout)
 
 
 # --------------------------------------------------------------------------------------------

@@ -18,7 +18,7 @@ Extension contract (for a new integrator class):
    available, else linear), followed by ``system.normalize``.
 4. Count work in ``self.counters``: ``n_steps, n_rejected, n_rhs, n_jac, n_factor, n_newton``.
 5. Register with :func:`register` (or pass the class itself to :func:`core.simulation.simulate`).
-6. Raise :class:`IntegrationFailure` (or let a :data:`core.errors.NUMERICAL_ERRORS` exception
+6. Raise :class:`IntegrationFailure` (or let a :data:`core.errors.RUN_FAILURES` exception
    through) for numerical failures only; any other exception is a bug and propagates.
 7. The base class calls ``system.begin_run`` on construction and ``system.accept_step`` after
    every accepted :meth:`step`; a method that takes several steps per call (``steps_to_output``)
@@ -32,7 +32,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import NUMERICAL_ERRORS, InputError, NumericalFailure, UnknownOptionError
+from ..errors import RUN_FAILURES, InputError, NumericalFailure, UnknownOptionError
 from ..registry import Registry
 from ..system import ConstrainedSystem
 
@@ -134,9 +134,9 @@ class Integrator:
             ok, msg = self._step_impl()
         except IntegrationFailure as exc:
             ok, msg = False, str(exc)
-        except NUMERICAL_ERRORS as exc:
-            # numerical failures only (singular matrices, non-finite values, no convergence);
-            # any other exception, e.g. a bug in a user element, propagates with its traceback
+        except RUN_FAILURES as exc:
+            # run failures only (singular matrices, non-finite values, no convergence, a table
+            # past its range); any other exception, e.g. a bug in a user element, propagates
             ok, msg = False, f"{type(exc).__name__}: {exc}"
         if ok and not (np.all(np.isfinite(self.q)) and np.all(np.isfinite(self.v))):
             ok, msg = False, "state became non-finite (NaN or Inf): the integration diverged"

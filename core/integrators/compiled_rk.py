@@ -50,9 +50,11 @@ import numba
 import numpy as np
 import scipy.integrate as _si
 
-from .. import compiled as _c
+from ..compiled import dynamics as _d
+from ..compiled import layout as _l
+from ..compiled import protocol as _p
+from ..errors import InputError, NotCompilable
 from .base import STATUS_FAILED, STATUS_FINISHED, STATUS_RUNNING, Integrator, register
-from ..errors import InputError
 from .index1 import DEFAULT_BAUMGARTE
 
 _jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
@@ -74,16 +76,15 @@ DEFAULT_STIFFNESS = "warn"
 
 
 @_jit_inline
-def _rhs(cd, ws, t, y, alpha, beta, out, lam, counters):
+def _rhs(cd, states, ws, lay, nq, constrained, t, y, alpha, beta, out, lam, counters):
     """Index-1 right-hand side ``out = (Z v, v̇)``; status code."""
-    nq = cd.n_q
     q = y[:nq]
     v = y[nq:]
     counters[C_RHS] += 1
-    if cd.m:
+    if constrained:
         counters[C_FACT] += 1
-    st = _c.accelerations(cd, ws, q, v, alpha, beta, out[nq:], lam)
-    _c.qdot(cd, q, v, out[:nq])
+    st = _d.accelerations(cd, states, ws, t, q, v, alpha, beta, out[nq:], lam)
+    _d.qdot(lay, q, v, out[:nq])
     return st
 
 
@@ -98,9 +99,9 @@ def _rms(e, y, y_new, rtol, atol):
 
 
 @_jit
-def advance(cd, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C, E, E3, E5, err_kind, err_exp,
-            rtol, atol, max_step, alpha, beta, projection, proj_tol, max_proj_iter, stiff_bound, stiff_action,
-            K, y_new, y_old, f_old, tmp, y_st, lam, counters, out_info):
+def advance(cd, states, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C, E, E3, E5, err_kind,
+            err_exp, rtol, atol, max_step, alpha, beta, projection, proj_tol, max_proj_iter, stiff_bound, stiff_action,
+            stateful, K, y_new, y_old, f_old, tmp, y_st, lam, counters, out_info):
     r"""Take accepted steps from ``t`` until ``t_stop`` (or ``max_steps``); ``y``, ``f`` updated in place.
 
     ``need_f``: evaluate ``f = F(t, y)`` first (initial state, after a projection); with
@@ -108,7 +109,8 @@ def advance(cd, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C,
     call site, where :func:`_rhs` is inlined (one copy of the kernels to compile).
     ``y_old``/``f_old`` receive the state and derivative at the start of the last accepted step.
     ``out_info = [t, h_abs, t_old, t_fail, t_stiff, h|λ|]``.  Returns an exit code: ``EXIT_REACHED``,
-    ``EXIT_MAX_STEPS`` or a failure (kernel status, ``EXIT_TOO_SMALL``, ``EXIT_STIFF``).
+    ``EXIT_MAX_STEPS`` or a failure (kernel status, ``EXIT_TOO_SMALL``, ``EXIT_STIFF``).  With
+    ``stateful``, the kinds' search-state kernels run after every accepted step (and only then).
 
     Stiffness test (Hairer's codes): ``h|λ| ≈ h ‖f(ŷ) − f(y_s)‖ / ‖ŷ − y_s‖`` from the last internal
     stage ``y_s`` (at ``c = 1``) and the new solution ``ŷ`` — a difference quotient of the Jacobian
@@ -118,13 +120,16 @@ def advance(cd, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C,
     n = y.shape[0]
     ns = B.shape[0]
     steps = 0
+    lay = cd.lay
+    nq = lay[4]
+    constrained = cd.act.shape[0] > 0
     while True:
         if need_f:
             for i in range(n):
                 tmp[i] = y[i]
-            st = _rhs(cd, ws, t, tmp, alpha, beta, f, lam, counters)
+            st = _rhs(cd, states, ws, lay, nq, constrained, t, tmp, alpha, beta, f, lam, counters)
             need_f = False
-            if st != _c.OK:
+            if st != _p.OK:
                 out_info[0] = t
                 out_info[3] = t
                 return st
@@ -159,7 +164,7 @@ def advance(cd, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C,
                 K[0, i] = f[i]
             # stages 1 … ns−1 and the FSAL evaluation at (t + h, y_new) through one call site
             # (the right-hand side is inlined here once)
-            st = _c.OK
+            st = _p.OK
             for s in range(1, ns + 1):
                 if s < ns:
                     for i in range(n):
@@ -179,10 +184,10 @@ def advance(cd, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C,
                         y_new[i] = y[i] + h * acc
                         tmp[i] = y_new[i]
                     ts = t + h
-                st = _rhs(cd, ws, ts, tmp, alpha, beta, K[s], lam, counters)
-                if st != _c.OK and st != _c.NONFINITE:
+                st = _rhs(cd, states, ws, lay, nq, constrained, ts, tmp, alpha, beta, K[s], lam, counters)
+                if st != _p.OK and st != _p.NONFINITE:
                     break
-            if st != _c.OK and st != _c.NONFINITE:
+            if st != _p.OK and st != _p.NONFINITE:
                 out_info[0] = t
                 out_info[3] = ts
                 return st
@@ -255,16 +260,22 @@ def advance(cd, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C,
             y[i] = y_new[i]
             f[i] = K[ns, i]
         if projection:
-            nq = cd.n_q
-            it = _c.project(cd, ws, y[:nq], y[nq:], proj_tol, max_proj_iter, counters)
+            it = _d.project(cd, ws, t_new, y[:nq], y[nq:], proj_tol, max_proj_iter, counters)
             if it < 0:
                 for i in range(n):  # keep the last good state
                     y[i] = y_old[i]
                     f[i] = f_old[i]
                 out_info[0] = t
                 out_info[3] = t_new
-                return _c.PROJECTION
+                return _p.PROJECTION
             need_f = True  # f at the projected state, evaluated at the top of the loop
+        if stateful:
+            st = _d.accept(cd, states, ws, t_new, y[:nq], y[nq:])
+            if st != _p.OK:
+                out_info[0] = t
+                out_info[3] = t_new
+                return st
+            need_f = True  # the search state changed: f at the new state with the new seed
         out_info[2] = t
         t = t_new
         steps += 1
@@ -305,16 +316,18 @@ class CompiledRK(Integrator):
     @classmethod
     def applicable(cls, system):
         try:
-            _c.compile_model(system)
-        except _c.NotCompilable as exc:
+            _l.compile_model(system)
+        except NotCompilable as exc:
             return str(exc)
         return None
 
     def __init__(self, system, t_span, q0=None, v0=None, **kw):
         super().__init__(system, t_span, q0, v0, **kw)
         o = self.options
-        self._cd = _c.compile_model(system)
-        self._ws = _c.make_workspace(self._cd)
+        self._cm = _l.compile_model(system)
+        self._cd = self._cm.data
+        self._states = self._cm.initial_states()
+        self._ws = _d.make_workspace(self._cm)
         self.alpha = self.beta = 0.0
         if self.stabilization == "baumgarte":
             self.alpha = float(o.get("alpha", DEFAULT_BAUMGARTE))
@@ -361,14 +374,14 @@ class CompiledRK(Integrator):
         self._h_abs = 0.0
         if self.stabilization == "projection":
             nq = system.n_q
-            it = _c.project(self._cd, self._ws, self._y[:nq], self._y[nq:], self.projection_tol,
+            it = _d.project(self._cd, self._ws, self.t, self._y[:nq], self._y[nq:], self.projection_tol,
                             self.max_projection_iter, self._cnt)
             if it < 0:
                 raise InputError(f"{self.name}: initial state of {system.name!r} cannot be projected onto the constraints")
         st = self._evaluate(self.t, self._y, self._f)
-        if st != _c.OK:
+        if st != _p.OK:
             raise InputError(f"{self.name}: right-hand side fails at the initial state of {system.name!r}: "
-                             f"{_c.STATUS_MESSAGES[st]}")
+                             f"{self._status_message(st)}")
         if self.h is not None:
             self._h_abs = min(self.h, self.t_bound - self.t)
         else:
@@ -378,18 +391,27 @@ class CompiledRK(Integrator):
         self.a = self._f[system.n_q :].copy()
 
     def _advance_kernel(self, t, y, f, need_f, t_stop, max_steps):
-        return advance(self._cd, self._ws, t, y, f, need_f, t_stop, self.t_bound, self._h_abs, max_steps,
-                       self._A, self._B, self._C, self._E, self._E3, self._E5, self._err_kind, self._err_exp,
-                       self.rtol, self.atol, self.max_step, self.alpha, self.beta, self.stabilization == "projection",
-                       self.projection_tol, self.max_projection_iter, self._stiff_bound, self._stiff_action,
-                       self._K, self._y_new, self._y_old, self._f_old, self._tmp, self._y_st, self._lam, self._cnt,
-                       self._info)
+        return advance(self._cd, self._states, self._ws, t, y, f, need_f, t_stop, self.t_bound, self._h_abs,
+                       max_steps, self._A, self._B, self._C, self._E, self._E3, self._E5, self._err_kind,
+                       self._err_exp, self.rtol, self.atol, self.max_step, self.alpha, self.beta,
+                       self.stabilization == "projection", self.projection_tol, self.max_projection_iter,
+                       self._stiff_bound, self._stiff_action, self._cm.stateful, self._K, self._y_new, self._y_old,
+                       self._f_old, self._tmp, self._y_st, self._lam, self._cnt, self._info)
 
     def _evaluate(self, t, y, out):
         """``out = F(t, y)`` through the compiled loop's right-hand side; kernel status code."""
         out[:] = 0.0
         code = self._advance_kernel(float(t), y, out, True, float(t), 0)
-        return _c.OK if code in (EXIT_REACHED, EXIT_MAX_STEPS) else code
+        return _p.OK if code in (EXIT_REACHED, EXIT_MAX_STEPS) else code
+
+    def _status_message(self, code) -> str:
+        """The failure of a kernel status code, naming the element that reported it."""
+        why = _p.STATUS_MESSAGES.get(code, f"kernel status {code}")
+        err = self._ws.err
+        if code not in (_p.SINGULAR, _p.NONFINITE, _p.PROJECTION) and err[2] in (1, 2):
+            family = "force" if err[2] == 1 else "constraint"
+            why = f"{self._cm.element_name(family, int(err[0]), int(err[1]))}: {why}"
+        return why
 
     def _initial_step(self, order):
         """Initial step of Hairer, Nørsett & Wanner I, Sec. II.4 (scipy's ``select_initial_step``)."""
@@ -401,7 +423,7 @@ class CompiledRK(Integrator):
         h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
         h0 = min(h0, interval)
         f1 = np.zeros_like(y0)
-        if self._evaluate(t0 + h0, y0 + h0 * f0, f1) != _c.OK:
+        if self._evaluate(t0 + h0, y0 + h0 * f0, f1) != _p.OK:
             f1[:] = np.nan
         d2 = float(np.sqrt(np.mean(((f1 - f0) / scale) ** 2))) / h0
         if d1 <= 1e-15 and d2 <= 1e-15:
@@ -463,11 +485,11 @@ class CompiledRK(Integrator):
             why = (f"the problem became stiff at t = {info[3]:.6g} s: h|λ| ≈ {info[5]:.3g} beyond the stability "
                    f"boundary {self._stiff_bound} of the method on {STIFF_STEPS} consecutive steps (Hairer's "
                    "stiffness test); use an implicit method (radau-ggl, generalized-alpha) or stiffness='warn'")
-        elif code == _c.PROJECTION:
+        elif code == _p.PROJECTION:
             why = (f"coordinate projection did not reach ‖Φ‖ ≤ {self.projection_tol:g} in "
                    f"{self.max_projection_iter} iterations at t = {info[3]:.6g} s")
         else:
-            why = f"{_c.STATUS_MESSAGES.get(code, f'kernel status {code}')} at t = {info[3]:.6g} s"
+            why = f"{self._status_message(code)} at t = {info[3]:.6g} s"
         self.status = STATUS_FAILED
         self.message = f"{self.name} failed at t = {self.t:.6g} s: {why}"
         return self.message

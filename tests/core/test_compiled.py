@@ -1,25 +1,45 @@
-"""Compiled (numba) kernels and the compiled explicit Runge–Kutta integrators.
+"""Compiled (numba) path: kernels, registration of element kinds, and the compiled integrators.
 
 Independent computations the compiled path is checked against:
 
-* the vectorised numpy path of :class:`core.model.Model` (Φ, Φ_q, γ, Q and the index-1
-  accelerations/multipliers of :func:`core.dynamics.accelerations`) for every compiled joint and
-  force kind, planar and spatial, at perturbed states (constraints violated, random velocities):
-  the formulas are the same, so they agree to round-off (1e-12 relative);
+* the vectorised numpy path of :class:`core.model.Model` (Φ, Φ_q, ν, γ, Q and the index-1
+  accelerations/multipliers of :func:`core.dynamics.accelerations`) for every compiled joint,
+  driver and force kind, planar and spatial, at perturbed states (constraints violated, random
+  velocities, t ≠ 0): the formulas are the same, so they agree to round-off (1e-12 relative);
 * scipy's ``RK45``/``DOP853`` driving the numpy right-hand side (same tableaux and step-size
   controller): with one output point the step sequences are identical, so step counts match exactly
   and the final states to the round-off accumulated over the run (1e-9 relative);
-* the minimal-coordinate reference of the N-link chain (core_benchmarks.md §1): the error scales
-  with the tolerance.
+* the minimal-coordinate reference of the N-link chain (core_benchmarks.md §1), the closed-form
+  slider-crank kinematics and the closed-form motion of a bead on a helix (a massless extra
+  coordinate): the error scales with the tolerance.
+
+A force kind defined in this test module (outside ``core/``) with its own kernel shows that domain
+packages join the compiled path through registration alone.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pytest
 
-from core import compiled, frames, models
+from core import drivers, frames, models
+from core.compiled import (
+    CompiledForces,
+    NotCompilable,
+    accept_kernel,
+    compile_model,
+    force_jacobian_kernel,
+    force_kernel,
+    make_workspace,
+)
+from core.compiled import dynamics as D
+from core.compiled import protocol as P
+from core.compiled.timefunctions import encode, evaluate
 from core.dynamics import accelerations as accelerations_numpy
+from core.errors import DataRangeError
+from core.forces import ForceElement, ForceEval, ForceJacobian, ForceKind
 from core.integrators import METHODS, simulate
 from core.integrators.compiled_rk import COMPILED_METHODS
 from core.model import ModelBuilder
@@ -42,8 +62,8 @@ def _body(b, rng, name):
     return b.add_body(name, rng.uniform(0.5, 2.0), R @ J @ R.T, rng.uniform(-1, 1, 3), orientation=p)
 
 
-def _model(dim, joint, seed, ground=False, springs=True):
-    """Two random bodies, one joint of the given kind, optionally a point spring and a spring-damper."""
+def _model(dim, joint, seed, ground=False, springs=True, loads=False):
+    """Two random bodies, one joint (or driver) of the given kind, optionally force elements."""
     rng = np.random.default_rng(seed)
     b = ModelBuilder(dim, f"compiled-{dim}d-{joint}")
     _body(b, rng, "a")
@@ -51,8 +71,10 @@ def _model(dim, joint, seed, ground=False, springs=True):
     bi = "ground" if ground else "a"
     at = rng.uniform(-1, 1, dim)
     axis = _unit(rng, dim)
-    if joint == "revolute":
+    if joint in ("revolute", "angle-driver"):
         b.add_revolute("J", bi, "b", at, None if dim == 2 else axis)
+        if joint == "angle-driver":
+            b.add_angle_driver("drive", "J", drivers.harmonic(0.3, 2.0, 0.1))
     elif joint == "spherical":
         b.add_spherical("J", bi, "b", at)
     elif joint == "translational":
@@ -66,11 +88,22 @@ def _model(dim, joint, seed, ground=False, springs=True):
         b.add_fixed("J", bi, "b", at)
     elif joint == "distance":
         b.add_distance("J", bi, "b", at, at + rng.uniform(0.3, 1.0, dim))
+    elif joint == "point-driver":
+        t = np.linspace(0.0, 2.0, 9)
+        b.add_point_driver("push", "b", at, axis, drivers.tabulated(t, 0.2 * np.sin(t) + 0.05 * t ** 2))
     if springs:
         b.add_point_spring("ps", "ground", "a", rng.uniform(-1, 1, dim), stiffness=150.0, damping=2.0)
         b.add_spring_damper("sd", "a", "b", rng.uniform(-1, 1, dim), rng.uniform(-1, 1, dim), 80.0, 1.5,
-                            free_length=0.4)
-    return b.build()
+                            free_length=0.4, actuator=drivers.polynomial([0.5, -1.0, 0.3]))
+    if loads:
+        b.add_applied_force("F", "a", rng.uniform(-1, 1, dim), [drivers.harmonic(2.0, 3.0), 1.5] + [0.5] * (dim - 2),
+                            frame="body")
+        b.add_applied_force("Fg", "b", rng.uniform(-1, 1, dim), [0.3] * dim)
+        b.add_applied_torque("T", "b", 0.7 if dim == 2 else [0.2, drivers.ramp(0.4), -0.1])
+        ball_at = (rng.uniform(-1, 1, dim))
+        b.add_plane_contact("C", "a", ball_at, 0.2, ball_at - 0.15 * _unit(rng, dim), _unit(rng, dim),
+                            restitution=0.8, impact_velocity=1.0, stiffness=1e4, friction=0.3)
+    return b.build(assemble=joint.endswith("driver"))
 
 
 def _perturbed(model, seed):
@@ -80,8 +113,9 @@ def _perturbed(model, seed):
     return q, v
 
 
-JOINTS_2D = ["revolute", "translational", "fixed", "distance"]
-JOINTS_3D = ["spherical", "revolute", "translational", "cylindrical", "universal", "fixed", "distance"]
+JOINTS_2D = ["revolute", "translational", "fixed", "distance", "angle-driver", "point-driver"]
+JOINTS_3D = ["spherical", "revolute", "translational", "cylindrical", "universal", "fixed", "distance",
+             "angle-driver", "point-driver"]
 CASES = [(2, j) for j in JOINTS_2D] + [(3, j) for j in JOINTS_3D]
 
 
@@ -92,74 +126,121 @@ def _close(a, b, what, rtol=RT):
     assert err <= rtol * scale, f"{what}: {err:.3e} > {rtol:g} × {scale:.3g}"
 
 
+def _jacobian_from_slots(cm, ws, model):
+    """Dense Φ_q (model rows) assembled from the kernels' slot blocks."""
+    f = cm.fields
+    J = np.zeros((cm.m_all, model.n_v))
+    for row in range(cm.m_all):
+        for slot in range(P.MAX_SLOTS):
+            blk = f["r_blk"][row, slot]
+            if blk < 0 or f["blk_w"][blk] == 0:
+                continue
+            o, w = f["blk_v0"][blk], f["blk_w"][blk]
+            J[row, o:o + w] += ws.G[row, slot, :w]
+    return J
+
+
 @pytest.mark.parametrize("ground", [False, True])
 @pytest.mark.parametrize("dim,joint", CASES)
 def test_kernels_match_numpy_model(dim, joint, ground):
-    model = _model(dim, joint, seed=len(joint) + dim, ground=ground)
-    cd = compiled.compile_model(model)
-    ws = compiled.make_workspace(cd)
+    model = _model(dim, joint, seed=len(joint) + dim, ground=ground, loads=not ground)
+    cm = compile_model(model)
+    ws = make_workspace(cm)
+    st = cm.initial_states()
     q, v = _perturbed(model, 3)
-    compiled.body_states(cd, q, v, ws)
-    compiled.constraint_terms(cd, ws, True, True)
-    _close(ws.phi[: model.n_c], model.Phi(0.0, q), f"{joint} Φ")
-    _close(ws.gam[: model.n_c], model.gamma(0.0, q, v), f"{joint} γ")
-    J = model.Phi_q(0.0, q).toarray()
-    Jc = np.zeros_like(J)
-    nvb = cd.nvb
-    for row in range(model.n_c):
-        for slot in range(2):
-            bdy = cd.r_b[row, slot]
-            if bdy < cd.nb:
-                Jc[row, bdy * nvb:(bdy + 1) * nvb] += ws.G[row, slot, :nvb]
-    _close(Jc, J, f"{joint} Φ_q")
+    t = 0.37
+    D.body_states(cm.fields["lay"], q, v, ws)
+    assert D.constraints(cm.data, ws, t, q, v, P.WANT_ALL) == P.OK
+    _close(ws.phi[: model.n_c], model.Phi(t, q), f"{joint} Φ")
+    _close(ws.nu[: model.n_c], model.nu(t, q), f"{joint} ν")
+    _close(ws.gam[: model.n_c], model.gamma(t, q, v), f"{joint} γ")
+    _close(_jacobian_from_slots(cm, ws, model), model.Phi_q(t, q).toarray(), f"{joint} Φ_q")
     Q = np.zeros(model.n_v)
-    assert compiled.applied_forces(cd, ws, Q) == compiled.OK
-    _close(Q, model.Q(0.0, q, v), f"{joint} Q")
+    assert D.forces(cm.data, st, ws, t, q, v, Q) == P.OK
+    _close(Q, model.Q(t, q, v), f"{joint} Q")
     a = np.zeros(model.n_v)
     lam = np.zeros(max(model.n_c, 1))
-    assert compiled.accelerations(cd, ws, q, v, 0.0, 0.0, a, lam) == compiled.OK
-    a_ref, lam_ref = accelerations_numpy(model, 0.0, q, v)
+    assert D.accelerations(cm.data, st, ws, t, q, v, 0.0, 0.0, a, lam) == P.OK
+    a_ref, lam_ref = accelerations_numpy(model, t, q, v)
     _close(a, a_ref, f"{joint} accelerations", 1e-10)
     _close(lam[: model.n_c], lam_ref, f"{joint} multipliers", 1e-10)
 
 
 def test_qdot_retract_normalize_match_model():
     model = _model(3, "spherical", seed=4)
-    cd = compiled.compile_model(model)
+    lay = compile_model(model).fields["lay"]
     q, v = _perturbed(model, 5)
     out = np.zeros(model.n_q)
-    compiled.qdot(cd, q, v, out)
+    D.qdot(lay, q, v, out)
     _close(out, model.qdot(q, v), "q̇")
     dv = 0.3 * np.random.default_rng(6).standard_normal(model.n_v)
     qr = q.copy()
-    compiled.retract(cd, qr, dv)
+    D.retract(lay, qr, dv)
     _close(qr, model.retract(q, dv), "retract")
     qn = 1.1 * q
-    compiled.normalize(cd, qn)
+    D.normalize(lay, qn)
     _close(qn, model.normalize(1.1 * q), "normalize")
 
 
 def test_baumgarte_terms_enter_the_acceleration_equation():
-    """With α, β the constraint rows satisfy Φ_q v̇ = γ − 2α Φ_q v − β² Φ (Baumgarte 1972)."""
-    model = _model(3, "revolute", seed=7, springs=False)
-    cd = compiled.compile_model(model)
-    ws = compiled.make_workspace(cd)
+    """With α, β the constraint rows satisfy Φ_q v̇ = γ − 2α (Φ_q v − ν) − β² Φ (Baumgarte 1972),
+    here with a driver (ν ≠ 0)."""
+    model = _model(3, "angle-driver", seed=7, springs=False)
+    cm = compile_model(model)
+    ws = make_workspace(cm)
     q, v = _perturbed(model, 8)
+    t = 0.21
     a = np.zeros(model.n_v)
     lam = np.zeros(model.n_c)
     alpha, beta = 7.0, 11.0
-    assert compiled.accelerations(cd, ws, q, v, alpha, beta, a, lam) == compiled.OK
-    J = model.Phi_q(0.0, q)
-    rhs = model.gamma(0.0, q, v) - 2 * alpha * (J @ v) - beta**2 * model.Phi(0.0, q)
+    assert D.accelerations(cm.data, cm.initial_states(), ws, t, q, v, alpha, beta, a, lam) == P.OK
+    J = model.Phi_q(t, q)
+    rhs = model.gamma(t, q, v) - 2 * alpha * (J @ v - model.nu(t, q)) - beta**2 * model.Phi(t, q)
     _close(J @ a, rhs, "Φ_q v̇")
-    _close(model.M(0.0, q) @ a + J.T @ lam, model.Q(0.0, q, v), "M v̇ + Φ_qᵀλ = Q")
+    _close(model.M(t, q) @ a + J.T @ lam, model.Q(t, q, v), "M v̇ + Φ_qᵀλ = Q")
 
 
 def test_rcm_envelope_is_a_band_on_chains():
     """The Schur complement of a chain is factorised in a band (row widths ≤ 4 in RCM order)."""
-    cd = compiled.compile_model(models.n_link_chain(32, planar=True))
-    widths = np.arange(cd.m) - cd.env_first
+    cm = compile_model(models.n_link_chain(32, planar=True))
+    widths = np.arange(cm.n_reg) - cm.fields["env_first"]
     assert widths.max() <= 4
+
+
+# --------------------------------------------------------------------------------------------
+# functions of time
+# --------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("fn", [
+    drivers.constant(1.7),
+    drivers.ramp(0.5, -0.2),
+    drivers.polynomial([0.1, -2.0, 0.7, 0.05]),
+    drivers.harmonic(0.3, 4.0, 0.2, 1.0),
+    drivers.tabulated(np.linspace(0.0, 2.0, 11), np.cos(np.linspace(0.0, 2.0, 11)) ** 2),
+])
+def test_compiled_time_functions_equal_the_numpy_ones(fn):
+    prog = encode(fn, "test")
+    for t in np.linspace(0.0, 2.0, 23):
+        st, *vals = evaluate(prog, t)
+        assert st == P.OK
+        _close(vals, fn(t), f"{fn!r} at t = {t}", 1e-13)
+
+
+def test_tabulated_function_past_its_range_is_a_status_not_a_value():
+    fn = drivers.tabulated([0.0, 0.5, 1.0, 1.5], [0.0, 0.2, 0.1, 0.4], label="angle table")
+    assert evaluate(encode(fn, "test"), 1.6)[0] == P.OUT_OF_RANGE
+    with pytest.raises(DataRangeError, match="angle table"):
+        fn(1.6)
+
+
+def test_python_callable_driver_is_refused_by_name():
+    b = ModelBuilder(2, "callable-drive")
+    b.add_body("m", 1.0, 0.1, (1.0, 0.0))
+    b.add_revolute("pin", "ground", "m", (0.0, 0.0))
+    b.add_angle_driver("spin", "pin", lambda t: 0.3 * t)
+    with pytest.raises(NotCompilable, match="driver 'spin'.*Python callable"):
+        compile_model(b.build(assemble=True))
 
 
 # --------------------------------------------------------------------------------------------
@@ -219,6 +300,66 @@ def test_projection_holds_both_constraint_levels():
     assert np.max(plain.position_violation) > 10 * tol  # the unstabilised index-1 ODE drifts
 
 
+def test_driven_slider_crank_on_the_compiled_path():
+    """Simeon's slider crank driven at 150 rad/s by a ramp (a compiled driver): the slider follows
+    x = r cos θ + √(l² − r² sin² θ) to the projection tolerance, as on the numpy path."""
+    model = models.slider_crank()
+    assert METHODS["jit-dop853-projection"].applicable(model) is None
+    t = np.linspace(0.0, 2 * np.pi / 150.0, 9)
+    res = simulate(model, (0.0, t[-1]), "jit-dop853-projection", t_eval=t, rtol=1e-8, atol=1e-10,
+                   projection_tol=1e-11, compute_multipliers=False)
+    ref = simulate(model, (0.0, t[-1]), "dop853-projection", t_eval=t, rtol=1e-8, atol=1e-10,
+                   projection_tol=1e-11, compute_multipliers=False)
+    assert res.status == "finished", res.message
+    p = models.SLIDER_CRANK_PARAMETERS
+    th = 150.0 * t
+    x_exact = p["l1"] * np.cos(th) + np.sqrt(p["l2"] ** 2 - (p["l1"] * np.sin(th)) ** 2)
+    slider = model.body_names.index("slider")
+    assert np.max(np.abs(res.q[:, 3 * slider] - x_exact)) < 1e-9
+    _close(res.q, ref.q, "jit vs numpy slider crank", 1e-8)
+
+
+def test_massless_extra_coordinate_bead_on_a_helix():
+    """The helix parameter s is a massless extra coordinate (the border of the compiled Schur solve):
+    s(t) = s0 + ṡ0 t − ½ g c t²/(R² + c²) is reproduced to the tolerance, as on the numpy path."""
+    model = models.body_on_helix()
+    assert METHODS["jit-dop853-projection"].applicable(model) is None
+    t = np.linspace(0.0, 1.0, 6)
+    res = simulate(model, (0.0, 1.0), "jit-dop853-projection", t_eval=t, rtol=1e-10, atol=1e-10,
+                   compute_multipliers=True)
+    assert res.status == "finished", res.message
+    s_ref, sd_ref = models.helix_analytic(t)
+    assert np.max(np.abs(res.q[:, -1] - s_ref)) < 1e-8
+    assert np.max(np.abs(res.v[:, -1] - sd_ref)) < 1e-8
+    cm = compile_model(model)
+    assert cm.n_x == 1  # one massless coordinate in the border
+    ws = make_workspace(cm)
+    q, v = _perturbed(model, 11)
+    a = np.zeros(model.n_v)
+    lam = np.zeros(model.n_c)
+    assert D.accelerations(cm.data, cm.initial_states(), ws, 0.0, q, v, 0.0, 0.0, a, lam) == P.OK
+    a_ref, lam_ref = accelerations_numpy(model, 0.0, q, v)
+    _close(a, a_ref, "helix accelerations", 1e-10)
+    _close(lam, lam_ref, "helix multipliers", 1e-10)
+
+
+@pytest.mark.parametrize("method", ["jit-dop853-projection", "jit-rk45-baumgarte"])
+def test_body_with_a_singular_mass_block_point_mass_pendulum(method):
+    """A point mass (no rotational inertia) has a singular mass block: its coordinates join the
+    border of the compiled saddle solve.  The pendulum's angle follows the exact Jacobi-elliptic
+    solution (IFToMM A01 geometry, released horizontally) to the tolerance."""
+    from core.workprecision import pendulum_angle_exact
+
+    model = models.simple_pendulum()
+    cm = compile_model(model)
+    assert cm.n_x == 3 and cm.n_reg == 0  # the bob's (x, y, θ) are border coordinates
+    t = np.linspace(0.0, 1.0, 5)
+    res = simulate(model, (0.0, 1.0), method, t_eval=t, rtol=1e-10, atol=1e-10, compute_multipliers=False)
+    assert res.status == "finished", res.message
+    angle = np.arctan2(res.q[:, 0], -res.q[:, 1])  # from the downward vertical
+    assert np.max(np.abs(angle - pendulum_angle_exact(t))) < 1e-7
+
+
 def test_steps_land_on_output_times_and_counters_add_up():
     model = models.n_link_chain(2, planar=True)
     t_eval = np.linspace(0.0, 1.0, 11)
@@ -250,17 +391,200 @@ def test_registry_names():
 
 
 # --------------------------------------------------------------------------------------------
+# an element kind defined outside core joins the compiled path by registration
+# --------------------------------------------------------------------------------------------
+
+
+@force_kernel
+def _drag_forces(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
+    """Linear drag ``F = −c ṙ`` at the centre of mass and ``M̄ = −c_r ω̄`` (fd: c, c_r; ix: body)."""
+    nb, dim = lay[P.L_NB], lay[P.L_DIM]
+    nvb = lay[P.L_NVB]
+    for e in range(ix.shape[0]):
+        b = ix[e, 0]
+        c, cr = fd[e, 0], fd[e, 1]
+        o = b * nvb
+        for i in range(dim):
+            Q[o + i] -= c * rd[b, i]
+        if dim == 2:
+            Q[o + 2] -= cr * w[b, 2]
+        else:
+            for i in range(3):
+                Q[o + 3 + i] -= cr * w[b, i]
+    _ = nb
+    return P.OK
+
+
+@force_jacobian_kernel
+def _drag_jacobian(t, q, v, r, A, rd, w, lay, fd, ix, state, K, D, err):
+    nvb, dim = lay[P.L_NVB], lay[P.L_DIM]
+    for e in range(ix.shape[0]):
+        o = ix[e, 0] * nvb
+        for i in range(nvb):
+            D[o + i, o + i] -= fd[e, 0] if i < dim else fd[e, 1]
+    return P.OK
+
+
+@dataclass(frozen=True)
+class Drag(ForceElement):
+    """Linear translational and rotational drag on a body (a force kind written outside core)."""
+
+    name: str
+    body: str
+    c: float
+    c_rot: float
+
+    @classmethod
+    def compile(cls, elements, ctx):
+        return DragKind(elements, ctx)
+
+
+class DragKind(ForceKind):
+    def __init__(self, elements, ctx):
+        self.names = [e.name for e in elements]
+        self.b = np.array([ctx.index(e.body, e.name) for e in elements], np.int64)
+        self.c = np.array([[e.c, e.c_rot] for e in elements], float)
+
+    def evaluate(self, bs, t):
+        d = bs.space.dim
+        Qb = np.zeros((len(self.b), bs.space.n_v))
+        Qb[:, :d] = -self.c[:, :1] * bs.rdot[self.b]
+        Qb[:, d:] = -self.c[:, 1:] * bs.w[self.b]
+        return ForceEval(self.b, Qb)
+
+    def jacobian(self, bs, t):
+        n, nv, d = len(self.b), bs.space.n_v, bs.space.dim
+        Kv = np.zeros((n, nv, nv))
+        for i in range(nv):
+            Kv[:, i, i] = -(self.c[:, 0] if i < d else self.c[:, 1])
+        return ForceJacobian(self.b, self.b, np.zeros((n, nv, nv)), Kv)
+
+    def compiled(self, layout):
+        return CompiledForces(forces=_drag_forces, fd=self.c, ix=self.b[:, None], names=self.names,
+                              jacobian=_drag_jacobian, what="drag")
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_element_kind_from_outside_core_runs_compiled(dim):
+    """A kind registered by a module outside core (this test) runs on the compiled integrators: same
+    forces as its numpy kind, and a freely falling body with drag follows the closed form
+    ``v(t) = −(g m/c)(1 − e^{−c t/m})``."""
+    b = ModelBuilder(dim, f"drag-{dim}d")
+    m, c = 2.0, 3.0
+    b.add_body("ball", m, 0.1 if dim == 2 else [0.1, 0.1, 0.1], np.zeros(dim),
+               angular_velocity=1.0 if dim == 2 else [0.0, 0.0, 1.0])
+    b.add_force(Drag("air", "ball", c, 0.5))
+    model = b.build()
+    cm = compile_model(model)
+    ws = make_workspace(cm)
+    q, v = _perturbed(model, 2)
+    Q = np.zeros(model.n_v)
+    D.body_states(cm.fields["lay"], q, v, ws)
+    assert D.forces(cm.data, cm.initial_states(), ws, 0.0, q, v, Q) == P.OK
+    _close(Q, model.Q(0.0, q, v), "drag Q")
+    res = simulate(model, (0.0, 1.0), "jit-dop853", t_eval=[1.0], rtol=1e-10, atol=1e-12)
+    assert res.status == "finished"
+    g = 9.81
+    v_exact = -(g * m / c) * (1.0 - np.exp(-c / m))
+    assert abs(res.v[-1, 1 if dim == 2 else 2] - v_exact) < 1e-8
+
+
+@accept_kernel
+def _count_accepts(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
+    state[0, 0] += 1.0
+    state[0, 1] = t
+    return P.OK
+
+
+@force_kernel
+def _seeded_spring(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
+    """A spring whose force reads the search state only as a seed: F = −k x (the count is not used)."""
+    b = ix[0, 0]
+    Q[b * lay[P.L_NVB]] -= fd[0, 0] * r[b, 0]
+    return P.OK
+
+
+@dataclass(frozen=True)
+class SeededSpring(ForceElement):
+    name: str
+    body: str
+    k: float
+
+    @classmethod
+    def compile(cls, elements, ctx):
+        return SeededSpringKind(elements, ctx)
+
+
+class SeededSpringKind(ForceKind):
+    stateful = True
+
+    def __init__(self, elements, ctx):
+        self.names = [e.name for e in elements]
+        self.b = np.array([ctx.index(e.body, e.name) for e in elements], np.int64)
+        self.k = np.array([e.k for e in elements])
+
+    def evaluate(self, bs, t):
+        Qb = np.zeros((len(self.b), bs.space.n_v))
+        Qb[:, 0] = -self.k * bs.r[self.b, 0]
+        return ForceEval(self.b, Qb)
+
+    def compiled(self, layout):
+        return CompiledForces(forces=_seeded_spring, fd=self.k[:, None], ix=self.b[:, None], names=self.names,
+                              accept=_count_accepts, state=np.zeros((1, 2)), what="seeded spring")
+
+
+def test_compiled_search_state_kernel_runs_on_accepted_steps_only():
+    """The accept kernel of a stateful kind runs once per accepted step (not per stage, rejected
+    attempt or output), and each run starts from the kind's initial state."""
+    b = ModelBuilder(2, "seeded")
+    b.add_body("m", 1.0, 0.1, (1.0, 0.0))
+    b.add_force(SeededSpring("spring", "m", 100.0))
+    model = b.build()
+    cm = compile_model(model)
+    assert cm.stateful
+    integ = METHODS["jit-dop853"](model, (0.0, 1.0), rtol=1e-6, atol=1e-8)
+    for t_out in np.linspace(0.1, 1.0, 10):
+        integ.advance(t_out)
+    assert integ.status == "finished"
+    count, t_last = integ._states[0], integ._states[1]
+    assert count == integ.counters["n_steps"] and integ.counters["n_rejected"] + integ.counters["n_steps"] < \
+        integ.counters["n_rhs"]
+    assert t_last == pytest.approx(1.0)
+    again = METHODS["jit-dop853"](model, (0.0, 1.0), rtol=1e-6, atol=1e-8)
+    assert again._states[0] == 0.0  # a fresh copy per run
+
+
+# --------------------------------------------------------------------------------------------
 # honest refusal and failure
 # --------------------------------------------------------------------------------------------
 
 
 def test_not_compilable_names_the_element():
-    with pytest.raises(compiled.NotCompilable, match="crank drive"):
-        simulate(models.slider_crank(), (0.0, 0.1), "jit-rk45")
-    with pytest.raises(compiled.NotCompilable, match="link1.*singular mass"):
-        compiled.compile_model(models.simple_pendulum())
-    reason = METHODS["jit-rk45"].applicable(models.body_on_helix())
-    assert reason is not None and "extra coordinate" in reason
+    b = ModelBuilder(2, "callable-actuator")
+    b.add_body("m", 1.0, 0.1, (1.0, 0.0))
+    b.add_spring_damper("muscle", "ground", "m", (0.0, 0.0), (1.0, 0.0), 10.0, actuator=lambda t: np.sin(t))
+    with pytest.raises(NotCompilable, match="spring-damper 'muscle'"):
+        simulate(b.build(), (0.0, 0.1), "jit-rk45")
+
+    from core.joints import UserConstraint
+
+    class Python(UserConstraint):
+        name, rows, bodies = "python-only", 1, ("m",)
+
+        def phi(self, t, q):
+            return np.array([q[self.q_index[0]] - 1.0])
+
+        def jacobian(self, t, q):
+            return np.array([[1.0, 0.0, 0.0]])
+
+        def gamma(self, t, q, v):
+            return np.zeros(1)
+
+    b = ModelBuilder(2, "user")
+    b.add_body("m", 1.0, 0.1, (1.0, 0.0))
+    b.add_joint(Python())
+    reason = METHODS["jit-rk45"].applicable(b.build())
+    assert reason is not None and "user constraint 'python-only'" in reason
     assert METHODS["jit-rk45"].applicable(models.n_link_chain(2, planar=True)) is None
 
 
@@ -277,8 +601,8 @@ def test_redundant_rows_must_be_removed():
         with pytest.warns(UserWarning, match="redundant constraint"):
             return b.build(redundant=redundant)
 
-    with pytest.raises(compiled.NotCompilable, match="redundant='remove'"):
-        compiled.compile_model(four_bar_spatial("keep"))
+    with pytest.raises(NotCompilable, match="redundant='remove'"):
+        compile_model(four_bar_spatial("keep"))
     res = simulate(four_bar_spatial("remove"), (0.0, 0.5), "jit-dop853-projection", n_output=3)
     assert res.status == "finished" and np.max(res.position_violation) < 1e-7
 
@@ -288,20 +612,21 @@ def test_coincident_spring_points_are_refused_with_a_message():
     b = ModelBuilder(2, "collapse")
     b.add_body("m", 1.0, 0.1, (0.0, 0.0))
     b.add_spring_damper("sd", "ground", "m", (0.0, 0.0), (0.0, 0.0), stiffness=10.0, free_length=0.5)
-    with pytest.raises(ValueError, match="attachment points of a spring-damper coincide"):
+    with pytest.raises(ValueError, match="spring-damper 'sd': the attachment points of a spring-damper coincide"):
         simulate(b.build(), (0.0, 1.0), "jit-rk45")
 
 
 def test_dependent_rows_give_a_non_positive_pivot():
     """The envelope Cholesky refuses a singular Schur complement (status code, not a wrong answer)."""
     model = models.n_link_chain(3, planar=True)
-    cd = compiled.compile_model(model)
-    ws = compiled.make_workspace(cd)
-    compiled.body_states(cd, model.q0, model.v0, ws)
-    compiled.constraint_terms(cd, ws, False, False)
-    assert compiled.factor_schur(cd, ws) == compiled.OK
+    cm = compile_model(model)
+    ws = make_workspace(cm)
+    q0, v0 = model.q0.copy(), model.v0.copy()  # writable: the kernels take mutable arrays
+    D.body_states(cm.fields["lay"], q0, v0, ws)
+    assert D.constraints(cm.data, ws, 0.0, q0, v0, 0) == P.OK
+    assert D.factor(cm.data, ws) == P.OK
     ws.G[1] = ws.G[0]  # both rows of the ground pivot made equal: dependent rows
-    assert compiled.factor_schur(cd, ws) == compiled.SINGULAR
+    assert D.factor(cm.data, ws) == P.SINGULAR
 
 
 def test_stiffness_test_warns_or_stops():

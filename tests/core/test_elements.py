@@ -24,7 +24,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from core import drivers, frames
-from core.forces import hertz_sphere_plane_stiffness
+from core.contact_laws import hertz_sphere_plane_stiffness
 from core.model import ModelBuilder
 
 EPS = 1e-6  # finite-difference step for positions / velocities

@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from core.errors import InputError, NameTakenError, UnknownNameError
 from railway.creep import (
     CREEP_MODELS,
     CreepModel,
@@ -285,9 +286,36 @@ def test_registry_names_aliases_classes_and_user_models():
         f = creep_forces("test_coulomb", 0.1, 0.0, 0.0, N0, A0, B0, G0, NU0, MU0)
         assert f.Fx[0] == pytest.approx(-MU0 * N0)
     finally:
-        CREEP_MODELS.pop("test_coulomb")
+        CREEP_MODELS.unregister("test_coulomb")
+    assert "test_coulomb" not in CREEP_MODELS
     with pytest.raises(ValueError, match="unknown creep model 'nope'"):
         get_creep_model("nope")
+
+
+def test_unknown_or_taken_names_raise_the_registry_errors():
+    # the registry is core.registry.Registry: an unknown name raises UnknownNameError listing the
+    # registered laws (it was a plain ValueError; a taken name raised TypeError from formatting
+    # the registered class with float())
+    with pytest.raises(UnknownNameError, match="unknown creep model 'nope'; registered: kalker_linear, "
+                                               "shen_hedrick_elkins, polach2000, polach2005, fastsim"):
+        get_creep_model("nope")
+    with pytest.raises(UnknownNameError, match="given as 'No-Pe'"):
+        get_creep_model("No-Pe")
+
+    class Other(CreepModel):
+        pass
+
+    with pytest.raises(NameTakenError, match="'polach2000' is taken by railway.creep.Polach2000"):
+        register_creep_model("polach2000", Other)
+    assert CREEP_MODELS["polach2000"] is Polach2000
+    assert register_creep_model("polach2000", Polach2000) is Polach2000  # same class again: no-op
+    with pytest.raises(TypeError, match="CreepModel subclasses"):
+        register_creep_model("not_a_law", int)
+    assert "not_a_law" not in CREEP_MODELS
+    with pytest.raises(InputError, match="parameters \\['join'\\] given with a model instance"):
+        get_creep_model(Polach2000(), join="raw")
+    with pytest.raises(InputError, match="must be a name, a CreepModel class or instance, got 3.0"):
+        get_creep_model(3.0)
 
 
 @pytest.mark.parametrize("model", ALL)
@@ -341,7 +369,7 @@ def test_creep_curve_table_and_figure(tmp_path):
 
 
 def test_creep_curve_from_curvatures_uses_hertz():
-    from railway.hertz import hertz_from_load
+    from core.contact_laws import hertz_from_load
 
     E, nu = 2.1e11, 0.3
     A, B = 1 / (2 * 0.46), 1 / (2 * 0.3)

@@ -1,17 +1,27 @@
 """Wheel-rail contact forces of a contact search (railway.forces).
 
 Oracles: the compiled kernel against the reference path built from the validated modules
-(railway.hertz, railway.creepage, railway.creep); Hertz's closed form N = K_h delta^1.5 at zero
-penetration rate; the force-opposes-creepage sign; force balance of the global force vector.
+(core.contact_laws, railway.creepage, railway.creep); the kernel's normal law against
+core.contact_laws; every creep law through ContactForces against the law called directly;
+Hertz's closed form N = K_h delta^1.5 at zero penetration rate; the force-opposes-creepage sign;
+force balance of the global force vector.
 """
 
 import numpy as np
 import pytest
 
+from core.contact_laws import HYSTERESIS_LAWS, hertz_from_penetration, hysteresis_force, relative_curvatures
+from core.errors import InputError, UnknownNameError
 from railway._kernels import HAVE_NUMBA
 from railway.contact_search import ContactSearch, wheelset_pose
-from railway.forces import FORCE_KEYS, ContactForces
-from railway.hertz import hertz_from_penetration
+from railway.creep import CREEP_MODELS, CreepModel, get_creep_model, register_creep_model
+from railway.forces import (
+    FORCE_KEYS,
+    ContactForces,
+    _compiled_normal_law,
+    lankarani_nikravesh_force,
+    wheel_rail_curvatures,
+)
 from railway.track import Curve, Straight, Track, Transition
 
 V = 30.0
@@ -95,3 +105,123 @@ def test_bad_input_names_the_value(contacts):
         ContactForces(mu=-0.1)
     with pytest.raises(ValueError, match="rolling speed"):
         ContactForces()(res, r, A, np.zeros_like(v), w)
+
+
+# ----------------------------------------------------------------------------- normal law
+
+def test_lankarani_nikravesh_limits():
+    K = 1e10
+    d = np.array([-1e-5, 1e-5, 1e-5, 1e-5])
+    dd = np.array([1.0, 0.0, 0.05, -50.0])
+    F = lankarani_nikravesh_force(d, dd, K, restitution=0.8)
+    hertz = K * 1e-5**1.5
+    assert F[0] == 0.0
+    assert F[1] == pytest.approx(hertz, rel=1e-14)  # steady rolling, no rate: pure Hertz
+    # floor 0.1 m/s used when no engagement velocity is given (documented steady-rolling choice)
+    assert F[2] == pytest.approx(hertz * (1 + 0.75 * 0.36 * 0.05 / 0.1), rel=1e-14)
+    assert F[3] == 0.0  # fast separation: clipped, never adhesive
+    F2 = lankarani_nikravesh_force(1e-5, 0.05, K, 0.8, approach_velocity=2.0)
+    assert F2[0] == pytest.approx(hertz * (1 + 0.75 * 0.36 * 0.05 / 2.0), rel=1e-14)
+    F3 = lankarani_nikravesh_force(1e-5, 0.05, K, 1.0)
+    assert F3[0] == pytest.approx(hertz, rel=1e-14)
+    with pytest.raises(ValueError, match="restitution must lie in \\[0, 1\\], got 1.5"):
+        lankarani_nikravesh_force(1e-5, 0.0, K, 1.5)
+    with pytest.raises(InputError, match="approach_velocity_floor must be > 0, got 0.0"):
+        lankarani_nikravesh_force(1e-5, 0.0, K, 0.8, approach_velocity_floor=0.0)
+    with pytest.raises(InputError, match="stiffness must be >= 0, got -1.0"):
+        lankarani_nikravesh_force(1e-5, 0.0, -1.0, 0.8)
+    # it is the law of core.contact_laws with v0 = max(|engagement velocity|, floor)
+    ref = HYSTERESIS_LAWS["lankarani-nikravesh"].force(d, dd, K, 0.8, approach_velocity=0.1)
+    np.testing.assert_array_equal(F, ref.force)
+    F4 = lankarani_nikravesh_force(d, dd, K, 0.8, approach_velocity=[0.01, -3.0, 0.5, 0.2])
+    ref4 = HYSTERESIS_LAWS["lankarani-nikravesh"].force(d, dd, K, 0.8, approach_velocity=[0.1, 3.0, 0.5, 0.2])
+    np.testing.assert_array_equal(F4, ref4.force)
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed")
+def test_kernel_normal_law_equals_core_contact_laws():
+    # the numba kernel writes Eq. (N1) of core.contact_laws out for one contact; both must agree
+    # on contact, no contact and the clip (fast separation), for every hysteresis factor
+    law = _compiled_normal_law()
+    rng = np.random.default_rng(4)
+    n = 500
+    d = np.concatenate([[-1e-5, 0.0], rng.uniform(-2e-5, 2e-4, n)])
+    dd = np.concatenate([[0.1, 0.1], rng.uniform(-3.0, 3.0, n)])
+    Kh = np.concatenate([[1e10, 1e10], rng.uniform(1e9, 5e11, n)])
+    v0 = np.concatenate([[0.1, 0.1], rng.uniform(0.05, 2.0, n)])
+    chi = np.concatenate([[0.3, 0.3], HYSTERESIS_LAWS["lankarani-nikravesh"].factor(rng.uniform(0.0, 1.0, n))])
+    F_kernel = np.array([law(*args) for args in zip(Kh, d, dd, chi, v0)])
+    F_core = hysteresis_force(d, dd, Kh, chi, v0, 1.5).force
+    assert np.count_nonzero(F_core == 0) > 50 and np.count_nonzero(F_core > 0) > 50
+    np.testing.assert_allclose(F_kernel, F_core, rtol=4e-16, atol=0)
+
+
+def test_wheel_rail_curvatures_is_core_with_wheel_and_rail_names():
+    A, B = wheel_rail_curvatures([0.46, 0.47], [np.inf, -0.5], [0.3, 0.013], [np.inf, 2.0])
+    A2, B2 = relative_curvatures([0.46, 0.47], [np.inf, -0.5], [np.inf, 2.0], [0.3, 0.013])
+    np.testing.assert_array_equal(A, A2)
+    np.testing.assert_array_equal(B, B2)
+    with pytest.raises(InputError, match="R1 = wheel, R2 = rail.*non-Hertzian contact at index 1"):
+        wheel_rail_curvatures([0.46, 0.46], [-0.014, -0.012], [0.013, 0.013])
+
+
+# ----------------------------------------------------------------------------- creep laws
+
+POLACH2005 = dict(k_A=0.6, k_S=0.2, A=0.38, B=0.7, speed=V)
+
+
+@pytest.mark.parametrize("compiled", ["auto", False])
+@pytest.mark.parametrize("model", sorted(CREEP_MODELS))
+def test_every_creep_law_through_contact_forces(contacts, model, compiled):
+    """ContactForces gives the forces of the creep law called directly with its own creepages,
+    semi-axes and normal force; exactly on the numpy path, to the kernel's table accuracy on the
+    compiled one (Kalker coefficients tabulated against ln(B/A), ~1e-5 relative)."""
+    res, r, A, v, w = contacts
+    params = POLACH2005 if model == "polach2005" else None
+    fc = ContactForces(creep_model=model, compiled=compiled, creep_params=params)
+    assert fc.creep_model == model
+    assert fc.compiled == (compiled == "auto" and HAVE_NUMBA and model in ("kalker_linear", "polach2000"))
+    f = fc(res, r, A, v, w)
+    on = f["N"] > 0
+    assert np.count_nonzero(on) >= 5
+    law = get_creep_model(model, **(params or {}))
+    direct = law(f["xi"][on], f["eta"][on], f["phi"][on], f["N"][on], f["a"][on], f["b"][on],
+                 fc.G, fc.nu, fc.mu)
+    for k in ("Fx", "Fy", "Mz"):
+        got = f[k][on]
+        want = getattr(direct, k)
+        if fc.compiled:
+            np.testing.assert_allclose(got, want, rtol=0, atol=1e-4 * np.max(np.abs(want)), err_msg=k)
+        else:
+            np.testing.assert_allclose(got, want, rtol=1e-13, atol=0, err_msg=k)
+    assert np.all(np.abs(f["Fx"][on]) > 0)
+
+
+def test_polach2005_is_not_replaced_by_another_law(contacts):
+    res, r, A, v, w = contacts
+    f5 = ContactForces(creep_model="polach2005", creep_params=POLACH2005)(res, r, A, v, w)
+    f0 = ContactForces(creep_model="polach2000", compiled=False)(res, r, A, v, w)
+    on = f0["N"] > 0
+    assert np.max(np.abs(f5["Fx"][on] - f0["Fx"][on])) > 1e-2 * np.max(np.abs(f0["Fx"][on]))
+    with pytest.raises(InputError, match="compiled=True, but the numba kernel implements only"):
+        ContactForces(creep_model="polach2005", compiled=True)
+    assert not ContactForces(creep_model=get_creep_model("polach2000", join="raw")).compiled
+    with pytest.raises(UnknownNameError, match="unknown creep model 'nope'; registered: kalker_linear"):
+        ContactForces(creep_model="nope")
+
+
+def test_user_creep_law_through_contact_forces(contacts):
+    res, r, A, v, w = contacts
+
+    class Coulomb(CreepModel):
+        def _forces(self, xi, eta, phi, N, a, b, G, nu, mu):
+            s = np.hypot(xi, eta)
+            return -mu * N * xi / s, -mu * N * eta / s, np.zeros_like(xi)
+
+    register_creep_model("test_coulomb_forces", Coulomb)
+    try:
+        f = ContactForces(creep_model="test_coulomb_forces")(res, r, A, v, w)
+    finally:
+        CREEP_MODELS.unregister("test_coulomb_forces")
+    on = f["N"] > 0
+    np.testing.assert_allclose(np.hypot(f["Fx"], f["Fy"])[on], 0.3 * f["N"][on], rtol=1e-12)

@@ -10,8 +10,8 @@ import argparse
 import numpy as np
 import pytest
 
+from core.contact_laws import hertz_from_load
 from railway.cli import register
-from railway.hertz import hertz_from_load
 from railway.quasi_static import quasi_static_contact
 from railway.two_point import conical_wheel, two_point_contact
 

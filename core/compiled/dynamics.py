@@ -1,0 +1,785 @@
+r"""The compiled equations of motion: forces, constraints, saddle-point solves, accelerations, projection.
+
+The same equations as the numpy path (:mod:`core.model`, :mod:`core.dynamics`), evaluated over
+the flat arrays of :func:`core.compiled.layout.compile_model` and the kinds' kernels:
+
+* :func:`body_states` — positions, rotation matrices and velocities of all bodies (3-D form);
+* :func:`forces` — gravity, gyroscopic moments ``−ω̄ × J ω̄`` and every force kind's kernel;
+* :func:`constraints` — every constraint kind's rows of ``Φ``, ``Φ_q`` (slot blocks), ``ν``, ``γ``;
+* :func:`factor` / :func:`saddle_solve` — ``[[M, Φ_qᵀ], [Φ_q, 0]] [x; μ] = [f; g]`` by the Schur
+  complement of the regular rows with the border of massless coordinates
+  (:mod:`core.compiled.layout`);
+* :func:`accelerations` — index-1 accelerations and multipliers with Baumgarte terms
+  (Baumgarte 1972): ``g = γ − 2α(Φ_q v − ν) − β²Φ``;
+* :func:`project` — coordinate projection (Eich 1993), the rule of
+  :func:`core.dynamics.project`: simplified Gauss–Newton ``[[M, Φ_qᵀ], [Φ_q, 0]] [Δ; μ] = [0; −Φ]``
+  with ``Φ_q`` and its factorisation frozen, ``q ← q ⊕ Δ`` until ``‖Φ‖∞ ≤ tol``, then the
+  M-orthogonal velocity correction onto ``Φ_q v = ν``;
+* :func:`force_jacobian` — ``∂Q/∂q`` (velocity-space increments) and ``∂Q/∂v`` from the kinds'
+  Jacobian kernels, by forward differences of a kind's force kernel where it has none;
+* :func:`qdot`, :func:`retract`, :func:`normalize` — coordinate kinematics of Euler parameters.
+
+Failures are status codes (:mod:`core.compiled.protocol`); a kernel that fails names its element
+in ``ws.err`` = (kind, element, family: 1 force, 2 constraint).
+
+References
+----------
+J. Baumgarte, Comput. Methods Appl. Mech. Eng. 1 (1972) 1–16.
+E. Eich, SIAM J. Numer. Anal. 30(5) (1993) 1467–1482.
+G. H. Golub, C. F. Van Loan, *Matrix Computations*, 4th ed., 2013, Alg. 3.4.1 (LU with partial
+pivoting), Alg. 4.2.1 (Cholesky) restricted to the envelope (George & Liu 1981, Ch. 4).
+P. E. Nikravesh, *Computer-Aided Analysis of Mechanical Systems*, 1988, Eq. 6.101 (Euler
+parameter rates).
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numba
+import numpy as np
+
+from .protocol import MAX_SLOTS, NONFINITE, OK, SINGULAR, WANT_GAMMA, WANT_NU, WANT_PHI
+
+__all__ = ["Workspace", "make_workspace", "body_states", "forces", "constraints", "factor", "saddle_solve",
+           "accelerations", "project", "accept", "force_jacobian", "qdot", "retract", "normalize", "PIVOT_RTOL",
+           "FAMILY_FORCE", "FAMILY_CONSTRAINT"]
+
+_jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
+_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+
+#: a Cholesky pivot below this fraction of its diagonal entry means numerically dependent rows
+PIVOT_RTOL = 1e-12
+FAMILY_FORCE, FAMILY_CONSTRAINT = 1, 2
+
+Workspace = namedtuple("Workspace", [
+    "r", "A", "rd", "w",           # body states (n_b + 1, 3 / 3×3)
+    "phi", "G", "nu", "gam",       # constraint rows (m_all; G (m_all, MAX_SLOTS, 6))
+    "X",                           # M⁻¹ Φ_qᵀ blocks (m_all, MAX_SLOTS, 6)
+    "S", "L", "rhs",               # Schur complement, envelope factor, right-hand side (m_R)
+    "C", "W", "T", "piv", "z",     # border: C (m_R, n_z), W = S⁻¹C, T (n_z, n_z) LU, pivots, z (n_z)
+    "Q", "g", "mu", "tmp_v", "tmp_v2", "err",
+])
+
+
+def make_workspace(cm) -> Workspace:
+    """Scratch arrays of the compiled equations (allocated once per integrator)."""
+    nb, m_all, n_v = cm.n_b, cm.m_all, cm.n_v
+    m_r = max(cm.n_reg, 1)
+    nz = cm.n_x + cm.n_e
+    A = np.zeros((nb + 1, 3, 3))
+    A[:, 2, 2] = 1.0  # planar bodies rotate about z (body_states writes the 2×2 block)
+    A[nb] = np.eye(3)
+    return Workspace(
+        r=np.zeros((nb + 1, 3)), A=A, rd=np.zeros((nb + 1, 3)), w=np.zeros((nb + 1, 3)),
+        phi=np.zeros(m_all), G=np.zeros((m_all, MAX_SLOTS, 6)), nu=np.zeros(m_all), gam=np.zeros(m_all),
+        X=np.zeros((m_all, MAX_SLOTS, 6)),
+        S=np.zeros((m_r, m_r)), L=np.zeros((m_r, m_r)), rhs=np.zeros(m_r),
+        C=np.zeros((m_r, max(nz, 1))), W=np.zeros((m_r, max(nz, 1))), T=np.zeros((max(nz, 1), max(nz, 1))),
+        piv=np.zeros(max(nz, 1), np.int64), z=np.zeros(max(nz, 1)),
+        Q=np.zeros(n_v), g=np.zeros(m_all), mu=np.zeros(m_all), tmp_v=np.zeros(n_v), tmp_v2=np.zeros(n_v),
+        err=np.zeros(3, np.int64),
+    )
+
+
+# ================================================================================================
+# kinematics
+# ================================================================================================
+
+
+@_jit
+def body_states(lay, q, v, ws):
+    """Fill ``ws.r, ws.A, ws.rd, ws.w`` in 3-D form; the ground row ``n_b`` stays at rest with A = I.
+
+    Planar bodies are embedded as rotations about z: ``A = [[c, −s, 0], [s, c, 0], [0, 0, 1]]``,
+    ``ω̄ = (0, 0, θ̇)``.  Spatial: ``A(p)`` of the Euler parameters (Nikravesh 1988, Eq. 6.19).
+    """
+    nb, dim = lay[0], lay[1]
+    r, A, rd, w = ws.r, ws.A, ws.rd, ws.w
+    if dim == 2:
+        for b in range(nb):
+            th = q[3 * b + 2]
+            c, s = np.cos(th), np.sin(th)
+            r[b, 0] = q[3 * b]
+            r[b, 1] = q[3 * b + 1]
+            A[b, 0, 0] = c
+            A[b, 0, 1] = -s
+            A[b, 1, 0] = s
+            A[b, 1, 1] = c
+            rd[b, 0] = v[3 * b]
+            rd[b, 1] = v[3 * b + 1]
+            w[b, 2] = v[3 * b + 2]
+    else:
+        for b in range(nb):
+            o = 7 * b
+            e0, e1, e2, e3 = q[o + 3], q[o + 4], q[o + 5], q[o + 6]
+            r[b, 0], r[b, 1], r[b, 2] = q[o], q[o + 1], q[o + 2]
+            A[b, 0, 0] = 2.0 * (e0 * e0 + e1 * e1) - 1.0
+            A[b, 0, 1] = 2.0 * (e1 * e2 - e0 * e3)
+            A[b, 0, 2] = 2.0 * (e1 * e3 + e0 * e2)
+            A[b, 1, 0] = 2.0 * (e1 * e2 + e0 * e3)
+            A[b, 1, 1] = 2.0 * (e0 * e0 + e2 * e2) - 1.0
+            A[b, 1, 2] = 2.0 * (e2 * e3 - e0 * e1)
+            A[b, 2, 0] = 2.0 * (e1 * e3 - e0 * e2)
+            A[b, 2, 1] = 2.0 * (e2 * e3 + e0 * e1)
+            A[b, 2, 2] = 2.0 * (e0 * e0 + e3 * e3) - 1.0
+            u = 6 * b
+            rd[b, 0], rd[b, 1], rd[b, 2] = v[u], v[u + 1], v[u + 2]
+            w[b, 0], w[b, 1], w[b, 2] = v[u + 3], v[u + 4], v[u + 5]
+
+
+@_jit
+def qdot(lay, q, v, out):
+    """``q̇ = Z(q) v``: identity for planar bodies and extras; ``ṗ = ½ L(p)ᵀ ω̄`` (Nikravesh 1988, Eq. 6.101)."""
+    nb, dim, n_q = lay[0], lay[1], lay[4]
+    if dim == 2:
+        for i in range(n_q):
+            out[i] = v[i]
+        return
+    for b in range(nb):
+        o, u = 7 * b, 6 * b
+        out[o], out[o + 1], out[o + 2] = v[u], v[u + 1], v[u + 2]
+        e0, e1, e2, e3 = q[o + 3], q[o + 4], q[o + 5], q[o + 6]
+        w0, w1, w2 = v[u + 3], v[u + 4], v[u + 5]
+        out[o + 3] = 0.5 * (-e1 * w0 - e2 * w1 - e3 * w2)
+        out[o + 4] = 0.5 * (e0 * w0 - e3 * w1 + e2 * w2)
+        out[o + 5] = 0.5 * (e3 * w0 + e0 * w1 - e1 * w2)
+        out[o + 6] = 0.5 * (-e2 * w0 + e1 * w1 + e0 * w2)
+    for k in range(lay[6]):
+        out[7 * nb + k] = v[6 * nb + k]
+
+
+@_jit
+def normalize(lay, q):
+    """Euler parameters scaled to unit norm in place (spatial bodies)."""
+    if lay[1] == 2:
+        return
+    for b in range(lay[0]):
+        o = 7 * b + 3
+        n = np.sqrt(q[o] ** 2 + q[o + 1] ** 2 + q[o + 2] ** 2 + q[o + 3] ** 2)
+        for i in range(4):
+            q[o + i] /= n
+
+
+@_jit
+def retract(lay, q, dv):
+    r"""``q ← q ⊕ Δ``: translations and extras add; spatial rotations ``p ← p ⊗ exp(Δθ̄/2)``."""
+    nb, dim = lay[0], lay[1]
+    if dim == 2:
+        for i in range(lay[4]):
+            q[i] += dv[i]
+        return
+    for b in range(nb):
+        o, u = 7 * b, 6 * b
+        for i in range(3):
+            q[o + i] += dv[u + i]
+        t0, t1, t2 = dv[u + 3], dv[u + 4], dv[u + 5]
+        ang = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+        if ang < 1e-4:
+            a2 = ang * ang
+            sh = 0.5 - a2 / 48.0 + a2 * a2 / 3840.0
+        else:
+            sh = np.sin(0.5 * ang) / ang
+        r0, r1, r2, r3 = np.cos(0.5 * ang), sh * t0, sh * t1, sh * t2
+        p0, p1, p2, p3 = q[o + 3], q[o + 4], q[o + 5], q[o + 6]
+        q[o + 3] = p0 * r0 - p1 * r1 - p2 * r2 - p3 * r3
+        q[o + 4] = p0 * r1 + r0 * p1 + (p2 * r3 - p3 * r2)
+        q[o + 5] = p0 * r2 + r0 * p2 + (p3 * r1 - p1 * r3)
+        q[o + 6] = p0 * r3 + r0 * p3 + (p1 * r2 - p2 * r1)
+    for k in range(lay[6]):
+        q[7 * nb + k] += dv[6 * nb + k]
+
+
+# ================================================================================================
+# forces and constraints through the kinds' kernels
+# ================================================================================================
+
+
+# Compiled code reads the fields of the model and workspace tuples into locals once per call:
+# reading a tuple field inside a loop reference-counts the array on every access (measured 15×
+# slower on the Schur assembly).
+
+
+@_inline
+def _ffd(cd, k):
+    """Data of force kind ``k`` (a C-contiguous view of the flat storage)."""
+    return cd.frc_fd[cd.frc_fo[k]:cd.frc_fo[k + 1]].reshape((cd.frc_n[k], cd.frc_fw[k]))
+
+
+@_inline
+def _fix(cd, k):
+    return cd.frc_ix[cd.frc_io[k]:cd.frc_io[k + 1]].reshape((cd.frc_n[k], cd.frc_iw[k]))
+
+
+@_inline
+def _fst(cd, states, k):
+    return states[cd.st_off[k]:cd.st_off[k + 1]].reshape((cd.st_n[k], cd.st_w[k]))
+
+
+@_jit
+def forces(cd, states, ws, t, q, v, Q):
+    """``Q``: gravity, gyroscopic moments and every force kind (call :func:`body_states` first)."""
+    lay = cd.lay
+    Qg = cd.Qg
+    nb, dim, n_v = lay[0], lay[1], lay[5]
+    for i in range(n_v):
+        Q[i] = Qg[i]
+    r, A, rd, w, err = ws.r, ws.A, ws.rd, ws.w, ws.err
+    if dim == 3:
+        J = cd.Jt
+        for b in range(nb):
+            w0, w1, w2 = w[b, 0], w[b, 1], w[b, 2]
+            h0 = J[b, 0, 0] * w0 + J[b, 0, 1] * w1 + J[b, 0, 2] * w2
+            h1 = J[b, 1, 0] * w0 + J[b, 1, 1] * w1 + J[b, 1, 2] * w2
+            h2 = J[b, 2, 0] * w0 + J[b, 2, 1] * w1 + J[b, 2, 2] * w2
+            Q[6 * b + 3] -= w1 * h2 - w2 * h1
+            Q[6 * b + 4] -= w2 * h0 - w0 * h2
+            Q[6 * b + 5] -= w0 * h1 - w1 * h0
+    n_frc = cd.n_frc
+    if n_frc:
+        frc = cd.frc
+        fd, fo, fn, fw = cd.frc_fd, cd.frc_fo, cd.frc_n, cd.frc_fw
+        ix, io, iw = cd.frc_ix, cd.frc_io, cd.frc_iw
+        st_off, st_n, st_w = cd.st_off, cd.st_n, cd.st_w
+        for k in range(n_frc):
+            st = frc[k](t, q, v, r, A, rd, w, lay, fd[fo[k]:fo[k + 1]].reshape((fn[k], fw[k])),
+                        ix[io[k]:io[k + 1]].reshape((fn[k], iw[k])),
+                        states[st_off[k]:st_off[k + 1]].reshape((st_n[k], st_w[k])), Q, err)
+            if st != OK:
+                err[0] = k
+                err[2] = 1
+                return st
+    for i in range(n_v):
+        if not np.isfinite(Q[i]):
+            return NONFINITE
+    return OK
+
+
+@_jit
+def constraints(cd, ws, t, q, v, flags):
+    """Every constraint kind's rows of Φ (flag), Φ_q, ν (flag), γ (flag) (after :func:`body_states`)."""
+    lay = cd.lay
+    r, A, rd, w, err = ws.r, ws.A, ws.rd, ws.w, ws.err
+    phi, G, nu, gam = ws.phi, ws.G, ws.nu, ws.gam
+    con = cd.con
+    fd, fo, fn, fw = cd.con_fd, cd.con_fo, cd.con_n, cd.con_fw
+    ix, io, iw, row0 = cd.con_ix, cd.con_io, cd.con_iw, cd.con_row0
+    for k in range(cd.n_con):
+        st = con[k](t, q, v, r, A, rd, w, lay, fd[fo[k]:fo[k + 1]].reshape((fn[k], fw[k])),
+                    ix[io[k]:io[k + 1]].reshape((fn[k], iw[k])), row0[k], flags, phi, G, nu, gam, err)
+        if st != OK:
+            err[0] = k
+            err[2] = 2
+            return st
+    return OK
+
+
+@_jit
+def accept(cd, states, ws, t, q, v):
+    """Search-state hook of the stateful force kinds after an accepted step at ``(t, q, v)``."""
+    lay = cd.lay
+    body_states(lay, q, v, ws)
+    r, A, rd, w, err = ws.r, ws.A, ws.rd, ws.w, ws.err
+    acc, stateful = cd.frc_acc, cd.frc_stateful
+    for k in range(cd.n_frc):
+        if stateful[k]:
+            st = acc[k](t, q, v, r, A, rd, w, lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k), err)
+            if st != OK:
+                err[0] = k
+                err[2] = 1
+                return st
+    return OK
+
+
+# ================================================================================================
+# saddle-point solves (see core.compiled.layout for the block elimination)
+# ================================================================================================
+
+
+@_inline
+def _minv_times(minv, b, wdt, src, so, dst, do):
+    """``dst[do:do+w] = M_b⁻¹ src[so:so+w]`` (fixed-size paths for planar and spatial bodies)."""
+    if wdt == 3:
+        x0, x1, x2 = src[so], src[so + 1], src[so + 2]
+        for i in range(3):
+            dst[do + i] = minv[b, i, 0] * x0 + minv[b, i, 1] * x1 + minv[b, i, 2] * x2
+    elif wdt == 6:
+        for i in range(6):
+            acc = 0.0
+            for j in range(6):
+                acc += minv[b, i, j] * src[so + j]
+            dst[do + i] = acc
+    else:
+        for i in range(wdt):
+            acc = 0.0
+            for j in range(wdt):
+                acc += minv[b, i, j] * src[so + j]
+            dst[do + i] = acc
+
+
+@_inline
+def _minv_times_row(minv, b, wdt, G, X, a, sl):
+    """``X[a, sl] = M_b⁻¹ G[a, sl]`` (one Jacobian row block)."""
+    if wdt == 3:
+        x0, x1, x2 = G[a, sl, 0], G[a, sl, 1], G[a, sl, 2]
+        for i in range(3):
+            X[a, sl, i] = minv[b, i, 0] * x0 + minv[b, i, 1] * x1 + minv[b, i, 2] * x2
+    else:
+        for i in range(wdt):
+            acc = 0.0
+            for j in range(wdt):
+                acc += minv[b, i, j] * G[a, sl, j]
+            X[a, sl, i] = acc
+
+
+@_jit
+def factor(cd, ws):
+    """``X = M⁻¹Φ_qᵀ`` blocks, ``S`` of the regular rows with its envelope Cholesky factor, and the
+    border ``C``, ``W = S⁻¹C``, ``T`` with its LU (:mod:`core.compiled.layout`); status code."""
+    reg, first, r_blk, blk_x, blk_w, minv, pat, ext = (cd.reg, cd.env_first, cd.r_blk, cd.blk_x, cd.blk_w, cd.minv,
+                                                       cd.pat, cd.ext)
+    rs_cnt, rs = cd.rs_cnt, cd.rs
+    S, L, G, X = ws.S, ws.L, ws.G, ws.X
+    m = reg.shape[0]
+    ne = ext.shape[0]
+    for k in range(m + ne):
+        a = reg[k] if k < m else ext[k - m]
+        for u in range(rs_cnt[a]):
+            _minv_times_row(minv, rs[a, u, 1], rs[a, u, 3], G, X, a, rs[a, u, 0])
+    for i in range(m):
+        for j in range(first[i], i + 1):
+            S[i, j] = 0.0
+    for p in range(pat.shape[0]):
+        a, sa, b, sb, wdt = pat[p, 0], pat[p, 1], pat[p, 2], pat[p, 3], pat[p, 6]
+        acc = 0.0
+        for c in range(wdt):
+            acc += G[a, sa, c] * X[b, sb, c]
+        S[pat[p, 4], pat[p, 5]] += acc
+    for i in range(m):
+        fi = first[i]
+        for j in range(fi, i + 1):
+            s = S[i, j]
+            k0 = fi if fi > first[j] else first[j]
+            for k in range(k0, j):
+                s -= L[i, k] * L[j, k]
+            if j == i:
+                if s != s:
+                    return NONFINITE
+                if not s > PIVOT_RTOL * S[i, i]:
+                    return SINGULAR
+                L[i, i] = np.sqrt(s)
+            else:
+                L[i, j] = s / L[j, j]
+    nx = cd.n_x
+    nz = nx + ne
+    if nz == 0:
+        return OK
+    C, W, T, xm, hpat, epat = ws.C, ws.W, ws.T, cd.xm, cd.hpat, cd.epat
+    for k in range(m):
+        for j in range(nz):
+            C[k, j] = 0.0
+        a = reg[k]
+        for sl in range(MAX_SLOTS):
+            b = r_blk[a, sl]
+            if b >= 0 and blk_x[b] >= 0:
+                for c in range(blk_w[b]):
+                    C[k, blk_x[b] + c] -= G[a, sl, c]
+    for p in range(hpat.shape[0]):  # H = G_RB M_B⁻¹ G_EBᵀ
+        a, sa, e_row, se, wdt = hpat[p, 0], hpat[p, 1], hpat[p, 2], hpat[p, 3], hpat[p, 6]
+        acc = 0.0
+        for c in range(wdt):
+            acc += G[a, sa, c] * X[e_row, se, c]
+        C[hpat[p, 4], nx + hpat[p, 5]] += acc
+    for j in range(nz):
+        for k in range(m):
+            W[k, j] = C[k, j]
+        _solve_envelope(L, first, m, W[:, j])
+    for i in range(nz):
+        for j in range(nz):
+            acc = 0.0
+            for k in range(m):
+                acc += C[k, i] * W[k, j]
+            T[i, j] = acc
+    for i in range(nx):
+        for j in range(nx):
+            T[i, j] += xm[i, j]
+    for e in range(ne):
+        a = ext[e]
+        for sl in range(MAX_SLOTS):
+            b = r_blk[a, sl]
+            if b >= 0 and blk_x[b] >= 0:
+                for c in range(blk_w[b]):
+                    x = blk_x[b] + c
+                    T[x, nx + e] += G[a, sl, c]
+                    T[nx + e, x] += G[a, sl, c]
+    for p in range(epat.shape[0]):  # −S_EE
+        a, sa, b, sb, wdt = epat[p, 0], epat[p, 1], epat[p, 2], epat[p, 3], epat[p, 6]
+        acc = 0.0
+        for c in range(wdt):
+            acc += G[a, sa, c] * X[b, sb, c]
+        T[nx + epat[p, 4], nx + epat[p, 5]] -= acc
+    return _lu_factor(T, nz, ws.piv)
+
+
+@_inline
+def _solve_envelope(L, first, m, b):
+    """Solve ``L Lᵀ x = b`` in place with the envelope factor."""
+    for i in range(m):
+        s = b[i]
+        for k in range(first[i], i):
+            s -= L[i, k] * b[k]
+        b[i] = s / L[i, i]
+    for i in range(m - 1, -1, -1):
+        b[i] /= L[i, i]
+        xi = b[i]
+        for k in range(first[i], i):
+            b[k] -= L[i, k] * xi
+
+
+@_jit
+def _lu_factor(T, n, piv):
+    """LU with partial pivoting of ``T[:n, :n]`` in place (Golub & Van Loan, Alg. 3.4.1); status."""
+    scale = 0.0
+    for i in range(n):
+        for j in range(n):
+            if abs(T[i, j]) > scale:
+                scale = abs(T[i, j])
+    for k in range(n):
+        p = k
+        big = abs(T[k, k])
+        for i in range(k + 1, n):
+            if abs(T[i, k]) > big:
+                big, p = abs(T[i, k]), i
+        piv[k] = p
+        if not big > PIVOT_RTOL * scale:
+            return SINGULAR
+        if p != k:
+            for j in range(n):
+                T[k, j], T[p, j] = T[p, j], T[k, j]
+        for i in range(k + 1, n):
+            T[i, k] /= T[k, k]
+            f = T[i, k]
+            for j in range(k + 1, n):
+                T[i, j] -= f * T[k, j]
+    return OK
+
+
+@_inline
+def _lu_solve(T, n, piv, b):
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            b[k], b[p] = b[p], b[k]
+    for i in range(n):
+        s = b[i]
+        for j in range(i):
+            s -= T[i, j] * b[j]
+        b[i] = s
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, n):
+            s -= T[i, j] * b[j]
+        b[i] = s / T[i, i]
+
+
+@_jit
+def saddle_solve(cd, ws, f, g, x, mu):
+    """Solve ``[[M, Φ_qᵀ], [Φ_q, 0]] [x; μ] = [f; g]`` with the factors of :func:`factor`
+    (block elimination of :mod:`core.compiled.layout`).
+
+    ``g`` and ``mu`` are indexed by model rows (``mu`` is written for the active rows).
+    """
+    reg, first, blk_v0, blk_w, blk_x, minv, ext = (cd.reg, cd.env_first, cd.blk_v0, cd.blk_w, cd.blk_x, cd.minv,
+                                                   cd.ext)
+    rs_cnt, rs, mass_blocks = cd.rs_cnt, cd.rs, cd.mass_blocks
+    G, X, rhs, z = ws.G, ws.X, ws.rhs, ws.z
+    # x_B0 = M_B⁻¹ f_B
+    for u in range(mass_blocks.shape[0]):
+        b = mass_blocks[u]
+        o = blk_v0[b]
+        _minv_times(minv, b, blk_w[b], f, o, x, o)
+    m = reg.shape[0]
+    for k in range(m):
+        a = reg[k]
+        acc = 0.0
+        for u in range(rs_cnt[a]):
+            sl, o, wdt = rs[a, u, 0], rs[a, u, 2], rs[a, u, 3]
+            for c in range(wdt):
+                acc += G[a, sl, c] * x[o + c]
+        rhs[k] = acc - g[a]
+    _solve_envelope(ws.L, first, m, rhs)
+    nx = cd.n_x
+    ne = ext.shape[0]
+    nz = nx + ne
+    if nz > 0:
+        C, W = ws.C, ws.W
+        for b in range(blk_x.shape[0]):
+            if blk_x[b] >= 0:
+                for c in range(blk_w[b]):
+                    z[blk_x[b] + c] = f[blk_v0[b] + c]
+        for e in range(ne):  # −r_E = g_E − G_EB M_B⁻¹ f_B
+            a = ext[e]
+            acc = 0.0
+            for u in range(rs_cnt[a]):
+                sl, o, wdt = rs[a, u, 0], rs[a, u, 2], rs[a, u, 3]
+                for c in range(wdt):
+                    acc += G[a, sl, c] * x[o + c]
+            z[nx + e] = g[a] - acc
+        for j in range(nz):
+            acc = 0.0
+            for k in range(m):
+                acc += C[k, j] * rhs[k]
+            z[j] += acc
+        _lu_solve(ws.T, nz, ws.piv, z)
+        for k in range(m):
+            acc = 0.0
+            for j in range(nz):
+                acc += W[k, j] * z[j]
+            rhs[k] -= acc
+    # x_B = x_B0 − M_B⁻¹ (G_RBᵀ μ_R + G_EBᵀ μ_E)
+    for k in range(m + ne):
+        if k < m:
+            a = reg[k]
+            mk = rhs[k]
+        else:
+            a = ext[k - m]
+            mk = z[nx + k - m]
+        mu[a] = mk
+        for u in range(rs_cnt[a]):
+            sl, o, wdt = rs[a, u, 0], rs[a, u, 2], rs[a, u, 3]
+            for c in range(wdt):
+                x[o + c] -= X[a, sl, c] * mk
+    if nz > 0:
+        for b in range(blk_x.shape[0]):
+            if blk_x[b] >= 0:
+                for c in range(blk_w[b]):
+                    x[blk_v0[b] + c] = z[blk_x[b] + c]
+
+
+@_inline
+def _row_dot(r_blk, blk_v0, blk_w, G, a, x):
+    """``(Φ_q x)_a`` for model row ``a``."""
+    acc = 0.0
+    for sl in range(MAX_SLOTS):
+        b = r_blk[a, sl]
+        if b >= 0 and blk_w[b] > 0:
+            o = blk_v0[b]
+            for c in range(blk_w[b]):
+                acc += G[a, sl, c] * x[o + c]
+    return acc
+
+
+@_jit
+def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
+    r"""Index-1 accelerations ``vdot`` and multipliers ``lam`` (active-row order); status code.
+
+    ``M v̇ + Φ_qᵀλ = Q``, ``Φ_q v̇ = γ − 2α(Φ_q v − ν) − β²Φ``.
+    """
+    lay, act, blk_v0, blk_w, minv, r_blk = cd.lay, cd.act, cd.blk_v0, cd.blk_w, cd.minv, cd.r_blk
+    Q = ws.Q
+    body_states(lay, q, v, ws)
+    st = forces(cd, states, ws, t, q, v, Q)
+    if st != OK:
+        return st
+    m = act.shape[0]
+    if m == 0:
+        mass_blocks = cd.mass_blocks
+        for u in range(mass_blocks.shape[0]):
+            b = mass_blocks[u]
+            o = blk_v0[b]
+            _minv_times(minv, b, blk_w[b], Q, o, vdot, o)
+        return OK
+    baum = alpha != 0.0 or beta != 0.0
+    flags = WANT_GAMMA
+    if baum:
+        flags = flags | WANT_PHI | WANT_NU
+    st = constraints(cd, ws, t, q, v, flags)
+    if st != OK:
+        return st
+    st = factor(cd, ws)
+    if st != OK:
+        return st
+    g, gam, nu, phi, G, mu = ws.g, ws.gam, ws.nu, ws.phi, ws.G, ws.mu
+    for k in range(m):
+        a = act[k]
+        ga = gam[a]
+        if baum:
+            ga -= 2.0 * alpha * (_row_dot(r_blk, blk_v0, blk_w, G, a, v) - nu[a]) + beta * beta * phi[a]
+        g[a] = ga
+    saddle_solve(cd, ws, Q, g, vdot, mu)
+    for k in range(m):
+        lam[k] = mu[act[k]]
+    for i in range(vdot.shape[0]):
+        if not np.isfinite(vdot[i]):
+            return NONFINITE
+    return OK
+
+
+@_inline
+def _max_abs_phi(act, phi):
+    mx = 0.0
+    for k in range(act.shape[0]):
+        x = abs(phi[act[k]])
+        if not x <= mx:  # NaN propagates
+            mx = x
+    return mx
+
+
+@_jit
+def project(cd, ws, t, q, v, tol, max_iter, counters):
+    """Coordinate projection of ``(q, v)`` in place (module docstring); returns iterations or −1.
+
+    ``counters[3]`` counts the factorisations.
+    """
+    lay, act, r_blk, blk_v0, blk_w = cd.lay, cd.act, cd.r_blk, cd.blk_v0, cd.blk_w
+    phi, nu, G, g, mu = ws.phi, ws.nu, ws.G, ws.g, ws.mu
+    normalize(lay, q)
+    m = act.shape[0]
+    if m == 0:
+        return 0
+    zero_f = ws.tmp_v
+    dq = ws.tmp_v2
+    for i in range(zero_f.shape[0]):
+        zero_f[i] = 0.0
+    body_states(lay, q, v, ws)
+    if constraints(cd, ws, t, q, v, WANT_PHI) != OK:
+        return -1
+    err = _max_abs_phi(act, phi)
+    n_iter = 0
+    if err > tol:
+        if factor(cd, ws) != OK:
+            return -1
+        counters[3] += 1
+        prev = np.inf
+        while True:
+            for k in range(m):
+                g[act[k]] = -phi[act[k]]
+            saddle_solve(cd, ws, zero_f, g, dq, mu)
+            retract(lay, q, dq)
+            n_iter += 1
+            # Φ at the new positions; the factors and M⁻¹Φ_qᵀ blocks stay frozen (constraints()
+            # rewrites Φ and the G blocks, which saddle_solve reads for the right-hand side only:
+            # they are restored at the velocity stage, which re-evaluates and refactorises)
+            body_states(lay, q, v, ws)
+            if constraints(cd, ws, t, q, v, WANT_PHI) != OK:
+                return -1
+            err = _max_abs_phi(act, phi)
+            if err <= tol:
+                break
+            if n_iter >= max_iter or not np.isfinite(err) or err > 2.0 * prev:
+                return -1
+            prev = err
+        normalize(lay, q)
+    # velocities at the projected positions: Φ_q (v + Δv) = ν, M-orthogonal
+    body_states(lay, q, v, ws)
+    if constraints(cd, ws, t, q, v, WANT_NU) != OK:
+        return -1
+    if factor(cd, ws) != OK:
+        return -1
+    counters[3] += 1
+    for k in range(m):
+        a = act[k]
+        g[a] = nu[a] - _row_dot(r_blk, blk_v0, blk_w, G, a, v)
+    saddle_solve(cd, ws, zero_f, g, dq, mu)
+    for i in range(v.shape[0]):
+        v[i] += dq[i]
+    return n_iter
+
+
+# ================================================================================================
+# force Jacobians (implicit integrators)
+# ================================================================================================
+
+
+@_jit
+def force_jacobian(cd, states, ws, t, q, v, K, D, qp, vp, Qa, Qb):
+    r"""``K = ∂Q/∂q`` along velocity-space increments and ``D = ∂Q/∂v`` of every force kind.
+
+    Kinds with a Jacobian kernel add their exact blocks; for the others, forward differences of
+    the kind's own force kernel with steps ``h = √ε`` along position increments and
+    ``h = √ε · max(1, |v_j|)`` along velocities (error O(h)).  The gyroscopic
+    moment's ∂/∂ω̄ is exact; gravity is constant.  ``qp, vp, Qa, Qb`` are work vectors.
+    """
+    lay = cd.lay
+    nb, dim, n_v = lay[0], lay[1], lay[5]
+    for i in range(n_v):
+        for j in range(n_v):
+            K[i, j] = 0.0
+            D[i, j] = 0.0
+    body_states(lay, q, v, ws)
+    if dim == 3:
+        J, w = cd.Jt, ws.w
+        for b in range(nb):
+            # ∂(−ω̄ × Jω̄)/∂ω̄ = −(ω̄~ J − (Jω̄)~)
+            w0, w1, w2 = w[b, 0], w[b, 1], w[b, 2]
+            h0 = J[b, 0, 0] * w0 + J[b, 0, 1] * w1 + J[b, 0, 2] * w2
+            h1 = J[b, 1, 0] * w0 + J[b, 1, 1] * w1 + J[b, 1, 2] * w2
+            h2 = J[b, 2, 0] * w0 + J[b, 2, 1] * w1 + J[b, 2, 2] * w2
+            for j in range(3):
+                # column j of ω̄~ J − (Jω̄)~ : ω̄ × J[:, j] − (Jω̄) × e_j
+                c0, c1, c2 = J[b, 0, j], J[b, 1, j], J[b, 2, j]
+                x0, x1, x2 = w1 * c2 - w2 * c1, w2 * c0 - w0 * c2, w0 * c1 - w1 * c0
+                e0 = 1.0 if j == 0 else 0.0
+                e1 = 1.0 if j == 1 else 0.0
+                e2 = 1.0 if j == 2 else 0.0
+                y0, y1, y2 = h1 * e2 - h2 * e1, h2 * e0 - h0 * e2, h0 * e1 - h1 * e0
+                D[6 * b + 3, 6 * b + 3 + j] -= x0 - y0
+                D[6 * b + 4, 6 * b + 3 + j] -= x1 - y1
+                D[6 * b + 5, 6 * b + 3 + j] -= x2 - y2
+    eps = 1.4901161193847656e-08
+    for k in range(cd.n_frc):
+        if cd.frc_has_jac[k]:
+            body_states(lay, q, v, ws)
+            st = cd.frc_jac[k](t, q, v, ws.r, ws.A, ws.rd, ws.w, lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k),
+                               K, D, ws.err)
+            if st != OK:
+                ws.err[0] = k
+                ws.err[2] = 1
+                return st
+            continue
+        # forward differences of this kind's forces
+        for i in range(n_v):
+            Qa[i] = 0.0
+        body_states(lay, q, v, ws)
+        st = cd.frc[k](t, q, v, ws.r, ws.A, ws.rd, ws.w, lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k), Qa,
+                       ws.err)
+        if st != OK:
+            ws.err[0] = k
+            ws.err[2] = 1
+            return st
+        for j in range(n_v):
+            for i in range(q.shape[0]):
+                qp[i] = q[i]
+            for i in range(n_v):
+                vp[i] = 0.0
+            h = eps
+            vp[j] = h
+            retract(lay, qp, vp)
+            body_states(lay, qp, v, ws)
+            for i in range(n_v):
+                Qb[i] = 0.0
+            st = cd.frc[k](t, qp, v, ws.r, ws.A, ws.rd, ws.w, lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k), Qb,
+                           ws.err)
+            if st != OK:
+                ws.err[0] = k
+                ws.err[2] = 1
+                return st
+            for i in range(n_v):
+                K[i, j] += (Qb[i] - Qa[i]) / h
+            for i in range(n_v):
+                vp[i] = v[i]
+            h = eps * max(1.0, abs(v[j]))
+            vp[j] += h
+            body_states(lay, q, vp, ws)
+            for i in range(n_v):
+                Qb[i] = 0.0
+            st = cd.frc[k](t, q, vp, ws.r, ws.A, ws.rd, ws.w, lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k), Qb,
+                           ws.err)
+            if st != OK:
+                ws.err[0] = k
+                ws.err[2] = 1
+                return st
+            for i in range(n_v):
+                D[i, j] += (Qb[i] - Qa[i]) / h
+    body_states(lay, q, v, ws)
+    return OK

@@ -1,0 +1,517 @@
+r"""Packing a frozen model into the flat arrays of the compiled path (model set-up, done once).
+
+:func:`compile_model` asks every constraint and force kind of a :class:`core.model.Model` for its
+compiled form (``kind.compiled(layout)``, :mod:`core.compiled.protocol`), and fixes what the
+numba code needs: the block structure of the velocity vector, the inverse mass blocks, the rows of
+``Φ_q`` and the blocks each touches, the sparsity pattern of the Schur complement and its
+bandwidth-reducing order, and the tuples of kernel function pointers.
+
+Blocks and the saddle-point solve
+---------------------------------
+The velocity vector is split into *blocks*: bodies (``n_v_body`` coordinates) and extra
+coordinates (width 1).  Blocks with a positive definite mass block ``M_b`` are eliminated through
+``M_b⁻¹``; the others — massless extra coordinates (a path parameter, fixed by constraints) and
+bodies with a singular mass block (a slider or a point mass without rotational inertia, whose
+rotation the joints fix) — form the *border* X with their (singular) mass matrix ``M_XX``.
+The regular rows R are an independent set of the rows touching blocks with ``M_b > 0`` (all of them
+without a border; chosen by pivoted QR at the initial configuration otherwise), so that
+``S = G_{RB} M_B^{-1} G_{RB}^T`` is positive definite; the other rows E (rows on border
+coordinates only, and the dependent remainder) join the border.  With ``x = (x_B, x_X)``,
+``μ = (μ_R, μ_E)`` and ``z = (x_X, μ_E)`` the system ``[[M, Gᵀ], [G, 0]] [x; μ] = [f; g]``
+is solved by block elimination of ``x_B`` and ``μ_R`` (Benzi, Golub & Liesen 2005, Sec. 5):
+
+.. math::
+
+    H = G_{RB} M_B^{-1} G_{EB}^T,\quad S_{EE} = G_{EB} M_B^{-1} G_{EB}^T,\quad
+    C = [\,-G_{RX}\;\;H\,],\quad
+    T = C^T S^{-1} C + \begin{bmatrix} M_{XX} & G_{EX}^T \\ G_{EX} & -S_{EE} \end{bmatrix},
+
+    r_R = G_{RB} M_B^{-1} f_B - g_R,\qquad r_E = G_{EB} M_B^{-1} f_B - g_E,\qquad
+    T z = C^T S^{-1} r_R + \begin{bmatrix} f_X \\ -r_E \end{bmatrix},
+
+    μ_R = S^{-1}(r_R - C z),\qquad x_B = M_B^{-1}(f_B - G_{RB}^T μ_R - G_{EB}^T μ_E).
+
+``S`` is factorised by the envelope Cholesky algorithm in reverse Cuthill–McKee order (George &
+Liu 1981, Ch. 4); ``T`` (size ``n_X + n_E``, symmetric indefinite) by LU with partial pivoting.
+Without border coordinates ``C``, ``T`` are empty and this is the plain Schur-complement solve.
+
+References
+----------
+M. Benzi, G. H. Golub, J. Liesen, "Numerical solution of saddle point problems", Acta Numerica
+14 (2005) 1–137.
+A. George, J. W. H. Liu, *Computer Solution of Large Sparse Positive Definite Systems*, 1981.
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import numpy as np
+import scipy.sparse as sp
+from numba.core import types
+from numba.experimental import structref
+from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+from ..errors import NotCompilable
+from .protocol import (
+    ACCEPT_SIGNATURE,
+    CONSTRAINT_SIGNATURE,
+    FORCE_JACOBIAN_SIGNATURE,
+    FORCE_SIGNATURE,
+    MAX_SLOTS,
+    OK,
+    CompiledConstraints,
+    CompiledForces,
+    accept_kernel,
+    constraint_kernel,
+    force_jacobian_kernel,
+    force_kernel,
+    resolve_kernel,
+)
+
+__all__ = ["Layout", "CompiledModel", "CompiledData", "compile_model", "KIND_CAPACITY"]
+
+#: Kernel tuples are padded with no-ops to this length (a tuple's length is part of its numba
+#: type), so the compiled code is compiled once for every model; a model with more kinds of one
+#: family is refused by name.
+KIND_CAPACITY = 16
+
+#: Fields of :class:`CompiledData`: the model's arrays ...
+MODEL_FIELDS = (
+    "lay",        # int64 (7,): see core.compiled.protocol.LAYOUT_FIELDS
+    "blk_v0",     # int64 (n_blk,): first velocity index of each block (bodies, ground, extras)
+    "blk_w",      # int64 (n_blk,): width (n_v_body, 0 for the ground, 1 for extras)
+    "blk_x",      # int64 (n_blk,): first index among the border coordinates, −1 for blocks with mass > 0
+    "minv",       # float (n_blk, 6, 6): inverse mass blocks (zero for the ground and massless)
+    "Qg",         # float (n_v,): gravity
+    "Jt",         # float (n_b + 1, 3, 3): inertia tensors (spatial gyroscopic moments)
+    "r_blk",      # int64 (m_all, MAX_SLOTS): block of each slot of each model row, −1 unused
+    "act",        # int64 (m,): active model rows (redundant rows removed)
+    "reg",        # int64 (m_R,): regular rows (touch a block with mass), in factorisation order
+    "ext",        # int64 (m_E,): rows touching only massless coordinates
+    "pat",        # int64 (n_p, 7): Schur pattern (a, slot_a, b, slot_b, i, j, width): S[i, j] += G[a,sa]·X[b,sb]
+    "env_first",  # int64 (m_R,): first column of each envelope row
+    "rs_cnt",     # int64 (m_all,): number of slots of a row on blocks with mass
+    "rs",         # int64 (m_all, MAX_SLOTS, 4): those slots: (slot, block, first velocity index, width)
+    "mass_blocks",  # int64: blocks with mass (bodies, extras with mass)
+    "n_x",        # int: border coordinates (blocks with a singular or zero mass matrix)
+    "xm",         # float (n_x, n_x): their mass matrix M_XX (block diagonal, singular)
+    "hpat",       # int64 (n_h, 7): (a, slot_a, e_row, slot_e, k, e, width): H[k, e] += G[a,sa]·X[e_row,se]
+    "epat",       # int64 (n_ee, 7): (e1_row, s1, e2_row, s2, e1, e2, width): S_EE[e1, e2] += G·X
+)
+#: ... and the kinds' kernels (tuples of function pointers padded to KIND_CAPACITY with no-ops)
+#: with their data stored flat: kind ``k`` reads ``fd[fo[k]:fo[k+1]].reshape(n[k], fw[k])`` and
+#: ``ix[io[k]:io[k+1]].reshape(n[k], iw[k])``; its search state is
+#: ``states[st_off[k]:st_off[k+1]].reshape(st_n[k], st_w[k])``.
+KERNEL_FIELDS = (
+    "n_con", "con", "con_fd", "con_fo", "con_n", "con_fw", "con_ix", "con_io", "con_iw", "con_row0",
+    "n_frc", "frc", "frc_fd", "frc_fo", "frc_n", "frc_fw", "frc_ix", "frc_io", "frc_iw",
+    "frc_jac", "frc_has_jac", "frc_acc", "frc_stateful", "st_off", "st_n", "st_w",
+)
+
+
+@structref.register
+class CompiledDataType(types.StructRef):
+    """numba type of :class:`CompiledData`."""
+
+    def preprocess_fields(self, fields):
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)
+
+
+class CompiledData(structref.StructRefProxy):
+    """Everything the compiled functions read about one model, in one object (a numba structref).
+
+    One object instead of tuples: passing it into compiled code costs ~2 µs, where a tuple of
+    ~40 arrays and function pointers costs ~0.2 ms of numba's argument typing per call.  Fields
+    :data:`MODEL_FIELDS` and :data:`KERNEL_FIELDS`; created by :func:`compile_model`.
+    """
+
+    def __new__(cls, *values):
+        return structref.StructRefProxy.__new__(cls, *values)
+
+
+structref.define_proxy(CompiledData, CompiledDataType, list(MODEL_FIELDS + KERNEL_FIELDS))
+
+
+class Layout:
+    """What a kind's ``compiled(layout)`` may ask for: sizes and the indices of extra coordinates.
+
+    Attributes
+    ----------
+    n_bodies, dim, n_q_body, n_v_body, n_q, n_v : int
+    extra_names : list of str
+    """
+
+    def __init__(self, model):
+        sp_ = model.space
+        self.model_name = model.name
+        self.n_bodies = model.n_bodies
+        self.dim = sp_.dim
+        self.n_q_body, self.n_v_body = sp_.n_q, sp_.n_v
+        self.n_q, self.n_v = model.n_q, model.n_v
+        self.extra_names = list(model.extra_names)
+
+    def extra_index(self, name: str, element: str) -> int:
+        """Index ``k`` of an extra coordinate (q index ``n_b n_q_body + k``, v index ``n_b n_v_body + k``)."""
+        try:
+            return self.extra_names.index(name)
+        except ValueError:
+            raise NotCompilable(f"{element}: unknown extra coordinate {name!r}") from None
+
+    def extra_q_index(self, name: str, element: str) -> int:
+        return self.n_bodies * self.n_q_body + self.extra_index(name, element)
+
+    def extra_v_index(self, name: str, element: str) -> int:
+        return self.n_bodies * self.n_v_body + self.extra_index(name, element)
+
+    def extra_slot(self, name: str, element: str) -> int:
+        """Jacobian slot block of an extra coordinate (:func:`core.compiled.protocol.extra_slot`)."""
+        return self.n_bodies + 1 + self.extra_index(name, element)
+
+
+# --- no-op kernels padding the tuples and standing in for a missing Jacobian or search state --------
+
+
+@constraint_kernel
+def _no_constraints(t, q, v, r, A, rd, w, lay, fd, ix, row0, flags, phi, G, nu, gam, err):
+    return OK
+
+
+@force_kernel
+def _no_forces(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
+    return OK
+
+
+@force_jacobian_kernel
+def _no_jacobian(t, q, v, r, A, rd, w, lay, fd, ix, state, K, D, err):
+    return OK
+
+
+@accept_kernel
+def _no_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
+    return OK
+
+
+class CompiledModel:
+    """A model packed for the compiled path (cached per model; see :func:`compile_model`).
+
+    Attributes
+    ----------
+    data : CompiledData
+        What the compiled functions read (one numba structref).
+    constraint_kinds, force_kinds : list
+        The compiled records of the kinds (for names in messages).
+    n_x, n_e, n_reg, m : int
+        Border coordinates (massless or of bodies with a singular mass block), rows on border
+        coordinates only, regular rows, active rows.
+    n_q, n_v, m_all : int
+    stateful : bool
+        Some force kind keeps a search state (copied per run by :meth:`initial_states`).
+    """
+
+    def __init__(self, model, fields: dict, constraint_kinds, force_kinds, states: np.ndarray):
+        self.name = model.name
+        self.fields = fields
+        self.data = CompiledData(*(fields[f] for f in MODEL_FIELDS + KERNEL_FIELDS))
+        self.constraint_kinds = constraint_kinds
+        self.force_kinds = force_kinds
+        self._states = states
+        self.n_x = int(fields["n_x"])
+        self.n_e = len(fields["ext"])
+        self.n_reg = len(fields["reg"])
+        self.m = len(fields["act"])
+        self.m_all = fields["r_blk"].shape[0]
+        self.n_b = int(fields["lay"][0])
+        self.n_q, self.n_v = int(fields["lay"][4]), int(fields["lay"][5])
+        self.stateful = bool(np.any(fields["frc_stateful"]))
+
+    def initial_states(self) -> np.ndarray:
+        """A fresh copy of the force kinds' search states (one per integrator run), stored flat
+        (see :data:`KERNEL_FIELDS`)."""
+        return self._states.copy()
+
+    def element_name(self, family: str, kind: int, element: int) -> str:
+        """Name of the element a kernel reported in ``err`` (family 'force' or 'constraint')."""
+        recs = self.force_kinds if family == "force" else self.constraint_kinds
+        if 0 <= kind < len(recs):
+            rec = recs[kind]
+            name = rec.names[element] if 0 <= element < len(rec.names) else "?"
+            return f"{rec.what} {name!r}"
+        return "an element"
+
+
+_CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def compile_model(model) -> CompiledModel:
+    """Pack a frozen :class:`core.model.Model` for the compiled path (cached per model).
+
+    Raises
+    ------
+    NotCompilable
+        For a system that is not a Cartesian model, an element kind without a compiled form (the
+        message names the element), a body with a singular mass block, redundant rows kept in the
+        model, or more than :data:`KIND_CAPACITY` kinds of one family.
+    """
+    from ..model import Model
+
+    if isinstance(model, Model):
+        try:
+            return _CACHE[model]
+        except (KeyError, TypeError):
+            pass
+    cm = _compile(model)
+    # the arrays stay writable at the numpy level (numba types a read-only array differently from
+    # the kernels' signatures); nothing writes to them after this point
+    try:
+        _CACHE[model] = cm
+    except TypeError:  # pragma: no cover - a model class without weak references
+        pass
+    return cm
+
+
+def _compile(model) -> CompiledModel:
+    from ..model import Model
+
+    if not isinstance(model, Model):
+        raise NotCompilable(f"compiled integrators need a core.model.Model, got {type(model).__name__} "
+                            f"{getattr(model, 'name', '')!r}; use the numpy integrators for hand-written systems")
+    if len(getattr(model, "redundant_rows", ())) and model._active_rows is None:
+        raise NotCompilable(f"model {model.name!r} keeps redundant constraint rows "
+                            f"({', '.join(model.redundant_constraints[:3])}...); build it with redundant='remove' "
+                            "for the compiled integrators (their Schur complement must be positive definite)")
+    layout = Layout(model)
+    sp_ = model.space
+    nb, dim, nvb = model.n_bodies, sp_.dim, sp_.n_v
+    ne = len(model.extra_names)
+    # --- constraint kinds (model row order: primitive kinds, then user constraints) ------------------
+    ckinds: list[CompiledConstraints] = []
+    row = 0
+    for kind in list(model.kinds) + list(model.user_constraints):
+        rec = _compiled_form(kind, layout, model)
+        if not isinstance(rec, CompiledConstraints):
+            raise NotCompilable(f"model {model.name!r}: constraint {_label(kind)!r} returned {type(rec).__name__} "
+                                "from compiled(), expected core.compiled.CompiledConstraints")
+        if rec.slots.shape != (rec.rows, MAX_SLOTS):
+            raise NotCompilable(f"model {model.name!r}: constraint {_label(kind)!r}: slots have shape "
+                                f"{rec.slots.shape}, expected ({rec.rows}, {MAX_SLOTS})")
+        rec._row0 = row  # noqa: SLF001 - bookkeeping of the packer
+        row += rec.rows
+        ckinds.append(rec)
+    m_all = row
+    if m_all != len(model._jac_indptr) - 1:
+        raise NotCompilable(f"model {model.name!r}: the compiled constraint kinds write {m_all} rows, "
+                            f"the model has {len(model._jac_indptr) - 1}")
+    r_blk = np.full((m_all, MAX_SLOTS), -1, np.int64)
+    for rec in ckinds:
+        r_blk[rec._row0:rec._row0 + rec.rows] = rec.slots
+    # --- blocks and masses ---------------------------------------------------------------------------
+    n_blk = nb + 1 + ne
+    blk_v0 = np.zeros(n_blk, np.int64)
+    blk_w = np.zeros(n_blk, np.int64)
+    blk_x = np.full(n_blk, -1, np.int64)
+    minv = np.zeros((n_blk, 6, 6))
+    Mcsr = model._M
+    border_mass = []  # mass blocks of the border coordinates (singular or zero)
+    nx = 0
+    for k, bd in enumerate(model.bodies):
+        blk = Mcsr[k * nvb:(k + 1) * nvb, k * nvb:(k + 1) * nvb].toarray()
+        if not np.all(np.isfinite(blk)):
+            raise NotCompilable(f"model {model.name!r}: body {bd.name!r} has a non-finite mass matrix")
+        blk_v0[k], blk_w[k] = k * nvb, nvb
+        if np.all(np.linalg.eigvalsh(0.5 * (blk + blk.T)) > 1e-14 * max(1.0, float(np.max(np.abs(blk))))):
+            minv[k, :nvb, :nvb] = np.linalg.inv(blk)
+        else:  # a singular mass block (zero inertia): its coordinates join the border
+            blk_x[k] = nx
+            nx += nvb
+            border_mass.append(blk)
+    blk_v0[nb] = -1  # the ground
+    for k in range(ne):
+        b = nb + 1 + k
+        blk_v0[b], blk_w[b] = nb * nvb + k, 1
+        mass = float(Mcsr[nb * nvb + k, nb * nvb + k])
+        if mass > 0:
+            minv[b, 0, 0] = 1.0 / mass
+        else:
+            blk_x[b] = nx
+            nx += 1
+            border_mass.append(np.array([[mass]]))
+    xm = np.zeros((max(nx, 1), max(nx, 1)))
+    o = 0
+    for blk in border_mass:
+        w_ = blk.shape[0]
+        xm[o:o + w_, o:o + w_] = blk
+        o += w_
+    # --- active, regular and E rows; Schur pattern and RCM order -------------------------------------
+    act = np.arange(m_all) if model._active_rows is None else np.asarray(model._active_rows, np.int64)
+    massive = (blk_w > 0) & (blk_x < 0)
+    reg_rows, ext_rows = [], []
+    for a in act:
+        blocks = [int(b) for b in r_blk[a] if b >= 0]
+        if any(massive[b] for b in blocks):
+            reg_rows.append(int(a))
+        elif blocks:
+            ext_rows.append(int(a))
+        else:
+            raise NotCompilable(f"model {model.name!r}: constraint row {int(a)} touches no coordinate")
+    if nx and reg_rows:
+        # with border coordinates, more rows may touch the blocks with mass than those blocks have
+        # freedoms: keep an independent set (pivoted QR of their rows restricted to the blocks with
+        # mass, at the initial configuration) as the regular rows and move the rest to E
+        J = model._Phi_q_all(0.0, model.q0).toarray()
+        cols = np.concatenate([np.arange(blk_v0[b], blk_v0[b] + blk_w[b]) for b in np.flatnonzero(massive)])
+        JB = J[np.ix_(reg_rows, cols)]
+        import scipy.linalg as sla
+
+        Rm, piv = sla.qr(JB.T, mode="r", pivoting=True)
+        diag = np.abs(np.diag(Rm)) if Rm.size else np.zeros(0)
+        rank = int(np.sum(diag > 1e-9 * max(1.0, diag[0] if len(diag) else 0.0)))
+        keep_rows = sorted(int(reg_rows[i]) for i in piv[:rank])
+        ext_rows = sorted(ext_rows + [int(reg_rows[i]) for i in piv[rank:]])
+        reg_rows = keep_rows
+    touching: dict[int, list[tuple[int, int]]] = {}
+    for ka, a in enumerate(reg_rows):
+        for slot in range(MAX_SLOTS):
+            b = int(r_blk[a, slot])
+            if b >= 0 and massive[b]:
+                touching.setdefault(b, []).append((ka, slot))
+    pairs = [(ka, sa, kb, sb) for lst in touching.values() for (ka, sa) in lst for (kb, sb) in lst]
+    m_r = len(reg_rows)
+    if m_r:
+        pr = np.array([p[0] for p in pairs] + list(range(m_r)), np.int64)
+        pc = np.array([p[2] for p in pairs] + list(range(m_r)), np.int64)
+        pattern = sp.csr_matrix((np.ones(len(pr)), (pr, pc)), shape=(m_r, m_r))
+        order = np.asarray(reverse_cuthill_mckee(pattern, symmetric_mode=True), np.int64)
+    else:
+        order = np.zeros(0, np.int64)
+    pos = np.empty(m_r, np.int64)
+    pos[order] = np.arange(m_r)
+    keep = [(ka, sa, kb, sb) for (ka, sa, kb, sb) in pairs if pos[ka] >= pos[kb]]
+    reg_arr = np.asarray(reg_rows, np.int64)
+    pat = np.array([(reg_arr[ka], sa, reg_arr[kb], sb, pos[ka], pos[kb], blk_w[r_blk[reg_arr[ka], sa]])
+                    for (ka, sa, kb, sb) in keep], np.int64).reshape(-1, 7)
+    env_first = np.arange(m_r, dtype=np.int64)
+    for i, j in zip(pat[:, 4], pat[:, 5]):
+        env_first[i] = min(env_first[i], j)
+    reg_sorted = reg_arr[order] if m_r else reg_arr  # regular rows in factorisation order
+    ext_arr = np.asarray(ext_rows, np.int64)
+    # couplings through blocks with mass of E rows with regular rows (H) and among themselves (S_EE)
+    e_touch: dict[int, list[tuple[int, int]]] = {}
+    for e, a in enumerate(ext_arr):
+        for slot in range(MAX_SLOTS):
+            b = int(r_blk[a, slot])
+            if b >= 0 and massive[b]:
+                e_touch.setdefault(b, []).append((e, slot))
+    hpat = np.array([(reg_arr[ka], sa, int(ext_arr[e]), se, pos[ka], e, blk_w[b])
+                     for b, lst in e_touch.items() for (e, se) in lst for (ka, sa) in touching.get(b, [])],
+                    np.int64).reshape(-1, 7)
+    epat = np.array([(int(ext_arr[e1]), s1, int(ext_arr[e2]), s2, e1, e2, blk_w[b])
+                     for b, lst in e_touch.items() for (e1, s1) in lst for (e2, s2) in lst], np.int64).reshape(-1, 7)
+    # compact tables of the blocks with mass, per row and overall (no branches on the hot path)
+    rs_cnt = np.zeros(m_all, np.int64)
+    rs = np.zeros((m_all, MAX_SLOTS, 4), np.int64)  # (slot, block, first velocity index, width)
+    for a in range(m_all):
+        for slot in range(MAX_SLOTS):
+            b = int(r_blk[a, slot])
+            if b >= 0 and massive[b]:
+                rs[a, rs_cnt[a]] = (slot, b, blk_v0[b], blk_w[b])
+                rs_cnt[a] += 1
+    mass_blocks = np.flatnonzero(massive).astype(np.int64)
+    # --- forces ----------------------------------------------------------------------------------------
+    fkinds: list[CompiledForces] = []
+    for fk in model.force_kinds:
+        rec = _compiled_form(fk, layout, model)
+        if not isinstance(rec, CompiledForces):
+            raise NotCompilable(f"model {model.name!r}: force element {fk.names[0]!r} returned {type(rec).__name__} "
+                                "from compiled(), expected core.compiled.CompiledForces")
+        fkinds.append(rec)
+    if len(ckinds) > KIND_CAPACITY or len(fkinds) > KIND_CAPACITY:
+        raise NotCompilable(f"model {model.name!r} has {len(ckinds)} constraint and {len(fkinds)} force kinds; "
+                            f"the compiled path takes at most {KIND_CAPACITY} of each")
+    Qg = np.asarray(model._Qg, float).copy()
+    Jt = np.zeros((nb + 1, 3, 3))
+    if dim == 3 and nb:
+        Jt[:nb] = model._J
+    lay = np.array([nb, dim, sp_.n_q, nvb, model.n_q, model.n_v, ne], np.int64)
+    fields = dict(lay=lay, blk_v0=blk_v0, blk_w=blk_w, blk_x=blk_x, minv=minv, Qg=Qg, Jt=Jt, r_blk=r_blk,
+                  act=np.asarray(act, np.int64), reg=np.ascontiguousarray(reg_sorted), ext=ext_arr,
+                  pat=np.ascontiguousarray(pat), env_first=env_first, rs_cnt=rs_cnt, rs=rs, mass_blocks=mass_blocks,
+                  n_x=np.int64(nx), xm=xm, hpat=np.ascontiguousarray(hpat), epat=np.ascontiguousarray(epat))
+    kernel_fields, states = _kernel_tuples(ckinds, fkinds)
+    fields.update(kernel_fields)
+    return CompiledModel(model, fields, ckinds, fkinds, states)
+
+
+def _label(kind) -> str:
+    labels = getattr(kind, "labels", None)
+    if labels:
+        return labels[0]
+    return getattr(kind, "name", type(kind).__name__)
+
+
+def _compiled_form(kind, layout, model):
+    fn = getattr(kind, "compiled", None)
+    if fn is None:
+        names = getattr(kind, "names", None) or getattr(kind, "labels", None) or [getattr(kind, "name", "?")]
+        raise NotCompilable(f"model {model.name!r}: element {names[0]!r} ({type(kind).__name__}) has no compiled kernel")
+    try:
+        return fn(layout)
+    except NotCompilable as exc:
+        raise NotCompilable(f"model {model.name!r}: {exc}") from None
+
+
+def _i2(a) -> np.ndarray:
+    a = np.asarray(a, np.int64)
+    return np.ascontiguousarray(a.reshape(a.shape[0], -1) if a.ndim else a.reshape(1, 1))
+
+
+def _f2(a) -> np.ndarray:
+    a = np.asarray(a, float)
+    return np.ascontiguousarray(a.reshape(a.shape[0], -1) if a.ndim else a.reshape(1, 1))
+
+
+def _stack(blocks: list[np.ndarray], dtype) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Blocks stored flat, one after the other: (flat, offsets, rows, widths); block k is
+    ``flat[off[k]:off[k+1]].reshape(rows[k], widths[k])`` (C-contiguous)."""
+    off = np.zeros(len(blocks) + 1, np.int64)
+    for k, b in enumerate(blocks):
+        off[k + 1] = off[k] + b.size
+    flat = np.zeros(max(int(off[-1]), 1), dtype)
+    for k, b in enumerate(blocks):
+        flat[off[k]:off[k + 1]] = np.ascontiguousarray(b, dtype).ravel()
+    rows = np.array([b.shape[0] for b in blocks] + [0], np.int64)
+    widths = np.array([b.shape[1] for b in blocks] + [0], np.int64)
+    return flat, off, rows, widths
+
+
+def _kernel_tuples(ckinds, fkinds) -> tuple[dict, np.ndarray]:
+    cap = KIND_CAPACITY
+
+    def res(k, role, sig, owner):
+        return resolve_kernel(k, role, sig, owner)
+
+    def pad(items, noop):
+        return tuple(items) + (noop.dispatcher,) * (cap - len(items))
+
+    con = pad([res(r.kernel, "constraint", CONSTRAINT_SIGNATURE, f"{r.what} {r.names[0]!r}") for r in ckinds],
+              _no_constraints)
+    con_fd, con_fo, con_n, con_fw = _stack([_f2(r.fd) for r in ckinds], float)
+    con_ix, con_io, _, con_iw = _stack([_i2(r.ix) for r in ckinds], np.int64)
+    con_row0 = np.array([r._row0 for r in ckinds] + [0], np.int64)
+    frc = pad([res(r.forces, "force", FORCE_SIGNATURE, f"{r.what} {r.names[0]!r}") for r in fkinds], _no_forces)
+    frc_fd, frc_fo, frc_n, frc_fw = _stack([_f2(r.fd) for r in fkinds], float)
+    frc_ix, frc_io, _, frc_iw = _stack([_i2(r.ix) for r in fkinds], np.int64)
+    frc_jac = pad([_no_jacobian.dispatcher if r.jacobian is None else
+                   res(r.jacobian, "force Jacobian", FORCE_JACOBIAN_SIGNATURE, f"{r.what} {r.names[0]!r}")
+                   for r in fkinds], _no_jacobian)
+    frc_has_jac = np.array([r.jacobian is not None for r in fkinds] + [False], np.int64)
+    frc_acc = pad([_no_accept.dispatcher if r.accept is None else
+                   res(r.accept, "accept", ACCEPT_SIGNATURE, f"{r.what} {r.names[0]!r}") for r in fkinds], _no_accept)
+    frc_stateful = np.array([r.accept is not None for r in fkinds] + [False], np.int64)
+    states, st_off, st_n, st_w = _stack([_f2(r.state) if r.state.size else np.zeros((0, 0)) for r in fkinds], float)
+    fields = dict(n_con=len(ckinds), con=con, con_fd=con_fd, con_fo=con_fo, con_n=con_n, con_fw=con_fw,
+                  con_ix=con_ix, con_io=con_io, con_iw=con_iw, con_row0=con_row0,
+                  n_frc=len(fkinds), frc=frc, frc_fd=frc_fd, frc_fo=frc_fo, frc_n=frc_n, frc_fw=frc_fw,
+                  frc_ix=frc_ix, frc_io=frc_io, frc_iw=frc_iw, frc_jac=frc_jac, frc_has_jac=frc_has_jac,
+                  frc_acc=frc_acc, frc_stateful=frc_stateful, st_off=st_off, st_n=st_n, st_w=st_w)
+    return fields, states

@@ -138,42 +138,47 @@ def _environment_versions() -> dict[str, str]:
 def run_metadata(
     *,
     method: str,
-    model_name: str = "",
+    system: str = "",
     rtol: float | None = None,
     atol: float | None = None,
-    step_size: float | None = None,
+    h: float | None = None,
     wall_time_s: float | None = None,
     **extra: Any,
 ) -> dict[str, Any]:
-    """Build the ``meta`` dict of a :class:`SimulationResult`.
+    """Build the ``meta`` dict of a :class:`SimulationResult` (the one definition of its keys).
+
+    :func:`core.simulation.simulate` writes its metadata with this function, so every result
+    carries the same keys.
 
     Parameters
     ----------
     method : str
-        Integrator / formulation name, e.g. ``"RK45+Baumgarte"``.
-    model_name : str, optional
-        Name of the simulated model.
+        Integrator registry name, e.g. ``"radau-ggl"``.
+    system : str, optional
+        Name of the simulated system.
     rtol, atol : float, optional
-        Requested relative and absolute tolerances (None for fixed-step methods).
-    step_size : float, optional
-        Fixed or initial step size [s].
+        Requested relative and absolute tolerances.
+    h : float, optional
+        Fixed (or initial) step size [s]; None for error-controlled runs without one.
     wall_time_s : float, optional
-        Wall-clock time of the run [s].
+        Time spent inside the integrator's steps [s].
     **extra
-        Further entries (e.g. Baumgarte parameters) stored verbatim.
+        Further entries stored verbatim (``simulate`` adds ``total_time_s``, ``t_end_reached``,
+        ``max_invariant_violation``).
 
     Returns
     -------
     dict
-        Metadata including ``"versions"`` from :func:`environment_versions`.
+        ``system, method, rtol, atol, h, wall_time_s``, the extra entries, and ``"versions"``
+        from :func:`environment_versions`.
     """
     meta: dict[str, Any] = {
+        "system": system,
         "method": method,
-        "model": model_name,
         "rtol": rtol,
         "atol": atol,
-        "step size [s]": step_size,
-        "wall time [s]": wall_time_s,
+        "h": h,
+        "wall_time_s": wall_time_s,
     }
     meta.update(extra)
     meta["versions"] = environment_versions()

@@ -28,6 +28,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from .errors import NameTakenError
+from .registry import Registry
+
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
     from matplotlib.figure import Figure
@@ -49,8 +52,13 @@ SCENE_ENTRY_POINT_GROUP = "mbsuite.scenes"
 _DEMO_MODULE = "core.demo_scenes"
 _NAME_RE = re.compile(r"^[a-z0-9][a-z0-9_\-]*$")
 
+def _check_scene(obj) -> None:
+    if not isinstance(obj, Scene):
+        raise TypeError(f"register_scene expects a Scene, got {type(obj).__name__}")
+
+
 #: Scenes registered in this process, by name (insertion order is listing order).
-_REGISTRY: dict[str, Scene] = {}
+_REGISTRY: Registry[Scene] = Registry("scene", _check_scene)
 
 
 class PluginLoadWarning(UserWarning):
@@ -149,18 +157,11 @@ class Scene:
 
 
 def register_scene(scene: Scene) -> Scene:
-    """Add a scene to the in-process registry and return it.
-
-    Re-registering the same object is a no-op (modules may be re-imported); a
-    different scene under an existing name raises :class:`ValueError`.
-    """
-    if not isinstance(scene, Scene):
-        raise TypeError(f"register_scene expects a Scene, got {type(scene).__name__}")
-    existing = _REGISTRY.get(scene.name)
-    if existing is not None and existing is not scene:
-        raise ValueError(f"a different scene named {scene.name!r} is already registered")
-    _REGISTRY[scene.name] = scene
-    return scene
+    """Add a scene to the in-process registry (:class:`core.registry.Registry`: re-registering the
+    same object is a no-op, a different scene under a taken name raises
+    :class:`core.errors.NameTakenError`) and return it."""
+    _check_scene(scene)
+    return _REGISTRY.register(scene.name, scene)
 
 
 def _scene_entry_points() -> list[importlib.metadata.EntryPoint]:
@@ -191,8 +192,8 @@ def all_scenes(on_error: Callable[[str, BaseException], None] | None = None) -> 
 
     Raises
     ------
-    ValueError
-        If two sources provide scenes with the same name.
+    core.errors.NameTakenError
+        If two sources provide scenes with the same name (a ``ValueError``).
     """
     on_error = _default_on_error if on_error is None else on_error
     if importlib.util.find_spec(_DEMO_MODULE) is not None:
@@ -211,7 +212,7 @@ def all_scenes(on_error: Callable[[str, BaseException], None] | None = None) -> 
             continue
         for scene in provided:
             if scene.name in scenes and scenes[scene.name] is not scene:
-                raise ValueError(
+                raise NameTakenError(
                     f"scene name {scene.name!r} is provided by both {source[scene.name]} and plug-in {label}"
                 )
             scenes[scene.name] = scene

@@ -30,7 +30,7 @@ import numpy as np
 from .dynamics import accelerations
 from .errors import RUN_FAILURES, InputError
 from .integrators.base import STATUS_FAILED, STATUS_RUNNING, Integrator, get_method
-from .results import SimulationResult
+from .results import SimulationResult, run_metadata
 from .system import ConstrainedSystem
 
 __all__ = ["simulate"]
@@ -158,9 +158,9 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
             for name, val in system.reactions(t, q, lam).items():
                 reactions.setdefault(name, []).append(val)
     reactions_arr = {n: np.array(v) for n, v in reactions.items() if len(v) == n_t}
-    meta = dict(
-        system=system.name,
+    meta = run_metadata(
         method=cls.name,
+        system=system.name,
         rtol=rtol,
         atol=atol,
         h=h,

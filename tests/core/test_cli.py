@@ -15,6 +15,8 @@ import pytest
 
 import core
 from core import cli, scenes
+from core.errors import NameTakenError
+from core.registry import Registry
 from core.scenes import PluginLoadWarning, Scene, SceneError, SceneResult, run_scene
 
 REPO = Path(__file__).resolve().parents[2]
@@ -46,7 +48,7 @@ BAD_SCENE = Scene("bad_scene", "Always fails", "Raises on purpose.", _broken_sce
 @pytest.fixture
 def registry(monkeypatch):
     """An isolated scene registry holding OK_SCENE and BAD_SCENE, and no plug-ins."""
-    reg: dict[str, Scene] = {}
+    reg = Registry("scene", scenes._check_scene)
     monkeypatch.setattr(scenes, "_REGISTRY", reg)
     monkeypatch.setattr(scenes, "_DEMO_MODULE", "core._no_such_demo_module")
     monkeypatch.setattr(scenes, "_scene_entry_points", lambda: [])
@@ -150,7 +152,7 @@ def test_scene_validation_and_duplicates(registry):
     with pytest.raises(ValueError, match="callable"):
         Scene("x", "t", "d", run=42)
     scenes.register_scene(OK_SCENE)  # same object again: fine
-    with pytest.raises(ValueError, match="already registered"):
+    with pytest.raises(NameTakenError, match="scene name 'ok-scene' is taken"):
         scenes.register_scene(Scene("ok-scene", "other", "", _table_scene))
 
 

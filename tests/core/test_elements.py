@@ -140,8 +140,15 @@ PLANAR_JOINTS = ["revolute", "translational", "fixed", "distance"]
 SPATIAL_JOINTS = ["spherical", "revolute", "translational", "cylindrical", "universal", "fixed", "distance"]
 MOTIONS = ["ramp", "harmonic", "tabulated"]
 
+def _helix_model(seed):
+    from core.models import body_on_helix
+
+    return body_on_helix(radius=0.3 + 0.1 * seed, pitch=0.15, sdot0=1.0 + seed)
+
+
 MODEL_CASES = (
-    [pytest.param(lambda s, k=k, g=g: _joint_planar(k, s, g), id=f"planar-{k}{'-ground' if g else ''}")
+    [pytest.param(_helix_model, id="spatial-user-constraint-helix")]
+    + [pytest.param(lambda s, k=k, g=g: _joint_planar(k, s, g), id=f"planar-{k}{'-ground' if g else ''}")
      for k in PLANAR_JOINTS for g in (False, True)]
     + [pytest.param(lambda s, k=k, g=g: _joint_spatial(k, s, g), id=f"spatial-{k}{'-ground' if g else ''}")
        for k in SPATIAL_JOINTS for g in (False, True)]
@@ -213,10 +220,18 @@ def test_constraint_derivatives(factory, seed):
 
 @pytest.mark.parametrize("factory", MODEL_CASES)
 def test_mass_matrix_spd_and_consistent_start(factory):
+    from core.analysis import null_space_basis
+
     m = factory(3)
     M = _dense(m.M(0.0, m.q0))
     np.testing.assert_allclose(M, M.T, atol=0)
-    assert np.min(np.linalg.eigvalsh(M)) > 0
+    # positive semi-definite (a massless extra coordinate has no inertia) and positive definite on
+    # the motions the constraints allow (null space of Φ_q): the equations of motion are regular
+    assert np.min(np.linalg.eigvalsh(M)) >= 0.0
+    N = null_space_basis(m.Phi_q(0.0, m.q0))
+    assert N.shape[1] == 0 or np.min(np.linalg.eigvalsh(N.T @ M @ N)) > 0
+    if not m.extra_names:
+        assert np.min(np.linalg.eigvalsh(M)) > 0
     # joints hold at the initial configuration they were declared in
     assert np.max(np.abs(m.Phi(0.0, m.q0))) < 1e-12
 
@@ -534,3 +549,45 @@ def test_energy_conserved_spring_pendulum(dim):
     # the drift bound scales with the requested tolerance
     assert drift[0] < 1e2 * 1e-6
     assert drift[1] < 1e2 * 1e-9
+
+
+# --------------------------------------------------------------------------------------------
+# coverage: a new kind cannot skip the finite-difference checks above
+# --------------------------------------------------------------------------------------------
+
+
+def _core_subclasses(base) -> set[type]:
+    """Concrete subclasses of ``base`` defined in the ``core`` package (not in tests)."""
+    out, todo = set(), list(base.__subclasses__())
+    while todo:
+        c = todo.pop()
+        todo.extend(c.__subclasses__())
+        if c.__module__.startswith("core.") and not c.__name__.startswith("_"):
+            out.add(c)
+    return out
+
+
+def test_every_force_element_kind_is_in_the_property_cases():
+    from core.forces import ForceElement
+
+    covered = set()
+    for dim in (2, 3):
+        for element in FORCE_ELEMENTS:
+            covered |= {type(f) for f in _force_model(dim, element).force_elements}
+    missing = _core_subclasses(ForceElement) - covered
+    assert not missing, f"force elements without finite-difference checks: {sorted(c.__name__ for c in missing)}"
+
+
+def test_every_joint_driver_and_primitive_kind_is_in_the_property_cases():
+    from core.constraints import PrimitiveKind
+    from core.joints import Joint, UserConstraint
+
+    joints, kinds = set(), set()
+    for case in MODEL_CASES:
+        m = case.values[0](0)
+        joints |= {type(j) for j in m.joints}
+        kinds |= {type(k) for k in m.kinds}
+    missing = (_core_subclasses(Joint) | _core_subclasses(UserConstraint)) - joints
+    assert not missing, f"joints/drivers without finite-difference checks: {sorted(c.__name__ for c in missing)}"
+    missing = {c for c in _core_subclasses(PrimitiveKind) if c.__module__ == "core.constraints"} - kinds
+    assert not missing, f"constraint primitives without finite-difference checks: {sorted(c.__name__ for c in missing)}"

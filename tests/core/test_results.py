@@ -50,7 +50,7 @@ def oscillator(n_t: int = 41, status: str = "finished", with_lam: bool = True) -
         status=status,
         message="reached t_end" if status == "finished" else "Newton failed at t=1.0",
         counters={"rhs": 120, "jacobians": 3},
-        meta=run_metadata(method="test", model_name="circle", rtol=1e-6, atol=1e-9, wall_time_s=0.25),
+        meta=run_metadata(method="test", system="circle", rtol=1e-6, atol=1e-9, wall_time_s=0.25),
         coordinate_names=["x [m]", "y [m]"],
         velocity_names=["vx [m/s]", "vy [m/s]"],
         constraint_names=["circle"],
@@ -193,9 +193,23 @@ def test_validation_messages(change, message):
 
 
 def test_run_metadata_and_versions():
-    meta = run_metadata(method="HHT", model_name="m", rtol=None, atol=None, step_size=1e-3, alpha=-0.1)
-    assert meta["step size [s]"] == 1e-3 and meta["alpha"] == -0.1
+    meta = run_metadata(method="HHT", system="m", rtol=None, atol=None, h=1e-3, alpha=-0.1)
+    assert meta["h"] == 1e-3 and meta["alpha"] == -0.1
     assert meta["versions"] == environment_versions()
+
+
+def test_simulate_writes_the_metadata_of_run_metadata():
+    """One definition of the metadata keys: a simulated result carries exactly run_metadata's keys
+    (plus the entries simulate adds) with the run's values."""
+    from core.models import simple_pendulum
+    from core.simulation import simulate
+
+    res = simulate(simple_pendulum(bob="rod"), (0.0, 0.1), "rk45", rtol=1e-5, atol=1e-7, n_output=3)
+    ref = run_metadata(method="rk45", system=res.meta["system"], rtol=1e-5, atol=1e-7, h=None, wall_time_s=0.0)
+    assert set(ref) <= set(res.meta)
+    assert set(res.meta) - set(ref) == {"total_time_s", "t_end_reached", "max_invariant_violation"}
+    assert res.meta["method"] == "rk45" and res.meta["rtol"] == 1e-5 and res.meta["t_end_reached"] == 0.1
+    assert res.meta["versions"] == environment_versions()
 
 
 # --------------------------------------------------------------------------------------

@@ -109,7 +109,12 @@ CASES = {  # creepages small enough that beta = F_lin/(mu N) ~ 1e-4: nonlinear t
 }
 
 
-@pytest.mark.parametrize("model", ["kalker_linear", "shen_hedrick_elkins", "polach2000", "polach2005"])
+#: laws checked against Kalker's linear theory at small creepage (FASTSIM: against the simplified
+#: theory it discretises, test_fastsim_small_creepage_against_simplified_theory)
+SMALL_CREEPAGE_MODELS = ["kalker_linear", "shen_hedrick_elkins", "polach2000", "polach2005"]
+
+
+@pytest.mark.parametrize("model", SMALL_CREEPAGE_MODELS)
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_small_creepage_limit_is_kalker_linear(model, case):
     xi, eta, phi = CASES[case]
@@ -183,12 +188,15 @@ def test_fastsim_converges_second_order():
 
 # ----------------------------------------------------------------------------- large creepage
 
-@pytest.mark.parametrize("model, tol", [
+SATURATION_CASES = [
     ("shen_hedrick_elkins", 1e-14),     # exactly mu N for beta >= 3
     ("polach2000", 1e-6),               # deficit (4/(3 pi)) eps^-3, eps ~ 1e4 here
     ("polach2005", 1e-6),
     ("fastsim", 5e-3),                  # sum of the discretised parabolic bound, 40 x 40 grid
-])
+]
+
+
+@pytest.mark.parametrize("model, tol", SATURATION_CASES)
 @pytest.mark.parametrize("direction", [(1.0, 0.0), (0.0, -1.0), (0.6, 0.8)])
 def test_large_creepage_saturates_at_mu_N(model, tol, direction):
     s = 0.5
@@ -411,3 +419,13 @@ def test_cli_creep_curve(tmp_path, capsys):
         bad.func(bad)
     assert exc.value.code == 2
     assert "mu must be > 0, got -0.1" in capsys.readouterr().err
+
+
+def test_every_registered_creep_law_is_in_the_property_lists():
+    """A new creep law cannot skip the property tests: every registered law is in the small-creepage
+    list (or is FASTSIM, checked against the simplified theory), in the saturation list (or is
+    Kalker's linear law, unsaturated by definition) and in the symmetry test (ALL)."""
+    registered = set(CREEP_MODELS)
+    assert registered <= set(SMALL_CREEPAGE_MODELS) | {"fastsim"}
+    assert registered <= {m for m, _ in SATURATION_CASES} | {"kalker_linear"}
+    assert registered == set(ALL)

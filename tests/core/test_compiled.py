@@ -646,3 +646,86 @@ def test_stiffness_test_warns_or_stops():
     assert rigid.status == "finished" and "stiff" not in rigid.message
     with pytest.raises(ValueError, match="stiffness must be one of"):
         simulate(stiff, (0.0, 0.02), "jit-rk45", stiffness="maybe")
+
+
+# --------------------------------------------------------------------------------------------
+# the compiled Radau IIA integrator (stiff problems)
+# --------------------------------------------------------------------------------------------
+
+
+def test_radau_registry_names():
+    from core.integrators.compiled_radau import RADAU_METHODS
+
+    assert set(RADAU_METHODS) == {"jit-radau", "jit-radau-baumgarte", "jit-radau-projection"}
+    assert all(name in METHODS for name in RADAU_METHODS)
+
+
+@pytest.mark.parametrize("method", ["jit-radau-projection", "jit-radau-baumgarte"])
+def test_radau_chain_against_minimal_coordinate_reference(method):
+    """8-link chain at t = 1 s: the error of the order-5 method falls with the tolerance and
+    reaches below 1e-8 m at rtol 1e-8 (the index-1 formulation with the saddle-point Newton solve)."""
+    model = models.n_link_chain(8, planar=True)
+    ref, _ = models.n_link_chain_reference(8)
+    errs = []
+    for tol in (1e-5, 1e-8):
+        res = simulate(model, (0.0, 1.0), method, t_eval=[1.0], rtol=tol, atol=tol, compute_multipliers=False)
+        assert res.status == "finished", res.message
+        errs.append(float(np.linalg.norm(models.chain_tip(model, res.q[-1]) - ref)))
+    assert errs[1] < 1e-8 and errs[1] < errs[0] / 100
+
+
+@pytest.mark.parametrize("k", [1e6, 1e8])
+def test_radau_stiff_chain_no_stability_limit(k):
+    """Penalty chain N = 2 (k = 1e6, 1e8 N/m, undamped): Radau IIA is L-stable, so its step follows the
+    accuracy asked for, never a stability bound (no stiffness warning); its error against the
+    resolved DOP853 reference falls with the tolerance.  Reference: core.workprecision's independent
+    penalty right-hand side at rtol 1e-12."""
+    from core.workprecision import _stiff_chain_tip_reference
+
+    model = models.n_link_chain(2, planar=True, stiff_k=k)
+    t_end = 0.2
+    ref = _stiff_chain_tip_reference(2, k, t_end=t_end)
+    errs = []
+    for tol in (1e-4, 1e-7):
+        res = simulate(model, (0.0, t_end), "jit-radau", t_eval=[t_end], rtol=tol, atol=tol, compute_multipliers=False)
+        assert res.status == "finished" and "stiff" not in res.message, res.message
+        errs.append(float(np.linalg.norm(models.chain_tip(model, res.q[-1]) - ref)))
+    assert errs[1] < errs[0] and errs[1] < 1e-6
+
+
+def test_radau_output_by_collocation_polynomial_and_projection():
+    """Outputs between steps come from the collocation polynomial (plus the linear blend of the
+    projection correction): they agree with a tight DOP853 run to the tolerance, and with
+    projection both constraint levels hold at every output."""
+    model = models.n_link_chain(4, planar=True)
+    t = np.linspace(0.0, 1.0, 201)
+    res = simulate(model, (0.0, 1.0), "jit-radau-projection", t_eval=t, rtol=1e-5, atol=1e-5, projection_tol=1e-10)
+    ref = simulate(model, (0.0, 1.0), "dop853-projection", t_eval=t, rtol=1e-11, atol=1e-11)
+    assert res.status == "finished"
+    assert res.counters["n_steps"] < len(t)  # fewer steps than outputs: outputs are interpolated
+    _close(res.q, ref.q, "Radau dense output", 1e-5)
+    assert np.max(res.position_violation) < 1e-5
+
+
+def test_radau_massless_coordinate_and_driver():
+    """The border of the compiled saddle solve (massless helix parameter) and a compiled driver
+    (slider crank) also run through the Radau loop."""
+    t = np.linspace(0.0, 1.0, 6)
+    res = simulate(models.body_on_helix(), (0.0, 1.0), "jit-radau-projection", t_eval=t, rtol=1e-9, atol=1e-9)
+    s_ref, _ = models.helix_analytic(t)
+    assert res.status == "finished" and np.max(np.abs(res.q[:, -1] - s_ref)) < 1e-8
+    model = models.slider_crank()
+    tt = np.linspace(0.0, 2 * np.pi / 150.0, 9)
+    res = simulate(model, (0.0, tt[-1]), "jit-radau-projection", t_eval=tt, rtol=1e-8, atol=1e-10)
+    p = models.SLIDER_CRANK_PARAMETERS
+    x = p["l1"] * np.cos(150 * tt) + np.sqrt(p["l2"] ** 2 - (p["l1"] * np.sin(150 * tt)) ** 2)
+    assert res.status == "finished" and np.max(np.abs(res.q[:, 3 * model.body_names.index("slider")] - x)) < 1e-8
+
+
+def test_radau_fails_honestly_on_a_singular_iteration_matrix():
+    """A free point mass (no inertia about its axis and nothing fixing its rotation): the iteration
+    matrix is singular and the run ends failed with that cause (not a wrong answer)."""
+    b = ModelBuilder(2, "free-point")
+    b.add_body("p", 1.0, 0.0, (0.0, 0.0))
+    res = simulate(b.build(), (0.0, 0.1), "jit-radau", n_output=3)
+    assert res.status == "failed" and ("singular" in res.message or "not positive" in res.message)

@@ -1,0 +1,898 @@
+r"""Radau IIA (order 5) on the index-1 formulation with a compiled step loop: the stiff integrator.
+
+Stiff multibody problems — penalty joints, bushings, Hertzian wheel–rail contacts with normal
+stiffness of order 1e9 N/m — limit every explicit method's step to its stability boundary
+(``h |λ| ≲ 3…6`` for the fastest mode), whatever the accuracy asked for.  This integrator is
+A- and L-stable: its step follows the accuracy of the motion, and it runs, like
+:mod:`core.integrators.compiled_rk`, entirely in compiled code over the kernels of
+:mod:`core.compiled` (any element kind with a compiled form).
+
+Formulation
+-----------
+State ``y = (q, v)``, ``q̇ = Z(q) v``, ``v̇ = a(t, q, v)`` from the index-1 equations
+``M a + Φ_qᵀλ = Q``, ``Φ_q a = γ − 2α(Φ_q v − ν) − β²Φ`` (:func:`core.compiled.dynamics.accelerations`),
+as ``"jit-radau"`` (α = β = 0), ``"jit-radau-baumgarte"`` (α = β = 10 s⁻¹ by default) and
+``"jit-radau-projection"`` (coordinate projection onto ``Φ = 0``, ``Φ_q v = ν`` after every step,
+:func:`core.compiled.dynamics.project`; the dense output is corrected as in
+:mod:`core.integrators.index1`).
+
+Method
+------
+The 3-stage Radau IIA collocation method (stiffly accurate, order 5) with RADAU5's simplified
+Newton iteration, error estimate and step-size controller (Hairer & Wanner II, Sec. IV.8; the
+same algorithm and constants as :class:`scipy.integrate.Radau` and :mod:`core.integrators.ggl`):
+the transformed stage system needs, per Newton iteration, one real solve with ``(μ_r/h) I − J``
+and one complex solve with ``(μ_c/h) I − J``.  The Jacobian of the index-1 right-hand side is not
+formed; its linear systems are solved through the second-order structure and the linearised
+saddle-point equations.  With ``μ`` one of ``μ_r/h``, ``μ_c/h``, for a right-hand side
+``(r_q, r_v)``:
+
+.. math::
+
+    Δq = (r_q + Z Δv)/μ,\qquad
+    \begin{bmatrix} μ M - D - K/μ & Φ_q^T \\ Φ_q & 0 \end{bmatrix}
+    \begin{bmatrix} Δv \\ δλ \end{bmatrix} =
+    \begin{bmatrix} M r_v + K Z^{+} r_q / μ \\
+                    (Φ_q r_v - (β²/μ) Φ_q Z^{+} r_q)/(μ + 2α + β²/μ) \end{bmatrix}
+
+with ``K = ∂Q/∂q`` (velocity-space increments), ``D = ∂Q/∂v``
+(:func:`core.compiled.dynamics.force_jacobian`: the kinds' analytic Jacobian kernels, differences
+otherwise) and ``Z⁺`` the map of coordinate increments to velocity-space increments
+(``δθ̄ = 2 L(p) δp`` for Euler parameters; Nikravesh 1988, Eq. 6.100).  This linearisation keeps
+the stiff force terms and the constraints exactly and drops the derivatives of ``Φ_q``, ``γ`` and
+the gyroscopic-free inertia terms, which are smooth: a simplified Newton iteration converges with
+it (the residual is exact), and the Jacobian is refreshed when the iteration slows (RADAU5's rule).
+The ``(n_v + m)`` matrices are assembled in reverse Cuthill–McKee order and factorised by banded LU
+with partial pivoting (Golub & Van Loan 2013, Alg. 4.3.5), real and complex, and the factors are
+reused over the steps in which the step size and the Jacobian stay unchanged (RADAU5 keeps the
+step when the predicted change is below 20 %).
+
+Error control is RADAU5's (estimate ``(γ₀/h − J)⁻¹ (f(y₀) + Σ eᵢ Zᵢ / h)``, norm
+``‖e / (atol + rtol |y|)‖_RMS``); there is no stability limit and so no stiffness warning.
+Failures are honest: a step below 10 ulp(t) (Newton not converging at any step, non-finite
+stages), a singular iteration matrix, a projection that does not converge or a kernel failure end
+the run with status ``failed``, the cause, the time and the element where one is to blame.
+
+References
+----------
+E. Hairer, G. Wanner, *Solving Ordinary Differential Equations II*, 2nd ed., Springer, 1996,
+Sec. IV.8 (RADAU5) and VII.1 (index-1 formulation of mechanical systems).
+G. H. Golub, C. F. Van Loan, *Matrix Computations*, 4th ed., 2013, Sec. 4.3 (band LU).
+E. Cuthill, J. McKee, "Reducing the bandwidth of sparse symmetric matrices", Proc. 24th ACM
+National Conference (1969) 157–172.
+P. E. Nikravesh, *Computer-Aided Analysis of Mechanical Systems*, Prentice Hall, 1988.
+"""
+
+from __future__ import annotations
+
+from collections import namedtuple
+
+import numba
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+from ..compiled import dynamics as _d
+from ..compiled import layout as _l
+from ..compiled import protocol as _p
+from ..errors import InputError, NotCompilable
+from .base import STATUS_FAILED, STATUS_FINISHED, STATUS_RUNNING, Integrator, register
+from .compiled_rk import (
+    C_FACT,
+    C_REJ,
+    C_RHS,
+    C_STEPS,
+    EXIT_MAX_STEPS,
+    EXIT_REACHED,
+    EXIT_TOO_SMALL,
+    _rhs,
+)
+from .ggl import MAX_FACTOR, MIN_FACTOR, MU_COMPLEX, MU_REAL, NEWTON_MAXITER, P, T, TI
+from .ggl import C as RADAU_C
+from .ggl import E as RADAU_E
+from .index1 import DEFAULT_BAUMGARTE
+
+_jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
+_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+
+# counters beyond compiled_rk's layout (steps, rejected, rhs, factorisations, ...)
+C_JAC, C_NEWTON = 7, 8
+EXIT_SINGULAR_MATRIX = 104
+
+#: Work arrays of the compiled Radau loop (allocated once per integrator).
+RadauWork = namedtuple("RadauWork", [
+    "Mden", "K", "D", "Gd", "KK_r", "KK_c", "piv_r", "piv_c", "band",  # Jacobian and factors
+    "ip",                                                               # RCM position of each unknown
+    "f", "y_new", "y_old", "Z", "W", "F", "dW", "Zt", "yt", "scale",    # stages
+    "rq_c", "rv_c", "dq_c", "dv_c", "b_c", "wv_c",                      # complex solve work
+    "rq", "rv", "dq", "dv", "b", "wv", "err", "tmp", "qp", "vp", "Qa", "Qb", "lam",
+    "Qpoly", "info",
+])
+
+
+# ================================================================================================
+# linear algebra: the iteration matrices in RCM order, banded LU with partial pivoting
+# ================================================================================================
+
+
+@_jit
+def _vspace(lay, q, dq, out):
+    """``Z⁺ δq``: coordinate increments to velocity-space increments (``δθ̄ = 2 L(p) δp``)."""
+    nb, dim = lay[0], lay[1]
+    if dim == 2:
+        for i in range(lay[4]):
+            out[i] = dq[i]
+        return
+    for b in range(nb):
+        o, u = 7 * b, 6 * b
+        out[u], out[u + 1], out[u + 2] = dq[o], dq[o + 1], dq[o + 2]
+        e0, e1, e2, e3 = q[o + 3], q[o + 4], q[o + 5], q[o + 6]
+        d0, d1, d2, d3 = dq[o + 3], dq[o + 4], dq[o + 5], dq[o + 6]
+        # L(p) = [−e, −ẽ + e0 I]  (Nikravesh 1988, Eq. 6.95);  δθ̄ = 2 L δp
+        out[u + 3] = 2.0 * (-e1 * d0 + e0 * d1 + e3 * d2 - e2 * d3)
+        out[u + 4] = 2.0 * (-e2 * d0 - e3 * d1 + e0 * d2 + e1 * d3)
+        out[u + 5] = 2.0 * (-e3 * d0 + e2 * d1 - e1 * d2 + e0 * d3)
+    for k in range(lay[6]):
+        out[6 * nb + k] = dq[7 * nb + k]
+
+
+@_jit
+def _assemble(mu, Mden, K, D, Gd, nv, m, ip, A):
+    """``A = P [[μM − D − K/μ, Gᵀ], [G, 0]] Pᵀ`` (RCM order ``ip``); ``mu`` real or complex."""
+    N = nv + m
+    for i in range(N):
+        for j in range(N):
+            A[i, j] = 0.0
+    for i in range(nv):
+        pi = ip[i]
+        for j in range(nv):
+            x = mu * Mden[i, j] - D[i, j] - K[i, j] / mu
+            if x != 0.0:
+                A[pi, ip[j]] = x
+    for r in range(m):
+        pr = ip[nv + r]
+        for j in range(nv):
+            g = Gd[r, j]
+            if g != 0.0:
+                A[pr, ip[j]] = g
+                A[ip[j], pr] = g
+
+
+@_jit
+def _band_lu(A, N, piv, band):
+    """LU with partial pivoting of ``A[:N, :N]`` restricted to its band (in place); status.
+
+    ``band = (kl, ku)`` of the matrix (scanned here); fill from row interchanges stays within
+    ``ku + kl`` above the diagonal (Golub & Van Loan 2013, Sec. 4.3.5).
+    """
+    kl = 0
+    ku = 0
+    scale = 0.0
+    for i in range(N):
+        for j in range(N):
+            a = abs(A[i, j])
+            if a != 0.0:
+                if i - j > kl:
+                    kl = i - j
+                if j - i > ku:
+                    ku = j - i
+                if a > scale:
+                    scale = a
+    band[0], band[1] = kl, ku
+    uw = ku + kl
+    for k in range(N):
+        last = min(N - 1, k + kl)
+        p = k
+        big = abs(A[k, k])
+        for i in range(k + 1, last + 1):
+            a = abs(A[i, k])
+            if a > big:
+                big, p = a, i
+        piv[k] = p
+        if not big > 1e-14 * scale:
+            return _p.SINGULAR
+        jlast = min(N - 1, k + uw)
+        if p != k:
+            for j in range(k, jlast + 1):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+        pivot = A[k, k]
+        for i in range(k + 1, last + 1):
+            f = A[i, k] / pivot
+            A[i, k] = f
+            if f != 0.0:
+                for j in range(k + 1, jlast + 1):
+                    A[i, j] -= f * A[k, j]
+    return _p.OK
+
+
+@_jit
+def _band_solve(A, N, piv, band, b):
+    """Solve with the factors of :func:`_band_lu` in place."""
+    kl, uw = band[0], band[0] + band[1]
+    for k in range(N):
+        p = piv[k]
+        if p != k:
+            b[k], b[p] = b[p], b[k]
+        bk = b[k]
+        if bk != 0.0:
+            for i in range(k + 1, min(N - 1, k + kl) + 1):
+                b[i] -= A[i, k] * bk
+    for i in range(N - 1, -1, -1):
+        s = b[i]
+        for j in range(i + 1, min(N - 1, i + uw) + 1):
+            s -= A[i, j] * b[j]
+        b[i] = s / A[i, i]
+
+
+@_jit
+def _newton_solve(lay, q, mu, Mden, K, Gd, nv, m, alpha, beta, A, piv, band, ip, rq, rv, dq, dv, b, wv):
+    r"""``(Δq, Δv)`` of ``(μ I − J)(Δq, Δv) = (r_q, r_v)`` through the saddle-point form (docstring)."""
+    nq = lay[4]
+    _vspace(lay, q, rq, wv)
+    for i in range(nv):
+        acc = 0.0 * mu
+        for j in range(nv):
+            acc += Mden[i, j] * rv[j] + K[i, j] * wv[j] / mu
+        b[ip[i]] = acc
+    denom = mu + 2.0 * alpha + beta * beta / mu
+    for r in range(m):
+        acc = 0.0 * mu
+        for j in range(nv):
+            acc += Gd[r, j] * (rv[j] - (beta * beta / mu) * wv[j])
+        b[ip[nv + r]] = acc / denom
+    _band_solve(A, nv + m, piv, band, b)
+    for i in range(nv):
+        dv[i] = b[ip[i]]
+    _d.qdot(lay, q, dv, dq)
+    for i in range(nq):
+        dq[i] = (rq[i] + dq[i]) / mu
+
+
+@_jit
+def _jacobian(cd, states, ws, rw, t, q, v):
+    """``K``, ``D`` and the active rows of ``Φ_q`` (dense) at ``(t, q, v)``; status."""
+    st = _d.force_jacobian(cd, states, ws, t, q, v, rw.K, rw.D, rw.qp, rw.vp, rw.Qa, rw.Qb)
+    if st != _p.OK:
+        return st
+    act = cd.act
+    m = act.shape[0]
+    if m == 0:
+        return _p.OK
+    _d.body_states(cd.lay, q, v, ws)
+    st = _d.constraints(cd, ws, t, q, v, 0)
+    if st != _p.OK:
+        return st
+    Gd, G, r_blk, blk_v0, blk_w = rw.Gd, ws.G, cd.r_blk, cd.blk_v0, cd.blk_w
+    nv = Gd.shape[1]
+    for k in range(m):
+        a = act[k]
+        for j in range(nv):
+            Gd[k, j] = 0.0
+        for sl in range(_p.MAX_SLOTS):
+            blk = r_blk[a, sl]
+            if blk >= 0 and blk_w[blk] > 0:
+                o = blk_v0[blk]
+                for c in range(blk_w[blk]):
+                    Gd[k, o + c] += G[a, sl, c]
+    return _p.OK
+
+
+@_jit
+def _factor_both(rw, h, nv, m, counters):
+    """Real and complex iteration matrices for step ``h``, assembled and factorised; status."""
+    mr = MU_REAL / h
+    mc = (MU_COMPLEX_RE + 1j * MU_COMPLEX_IM) / h
+    _assemble(mr, rw.Mden, rw.K, rw.D, rw.Gd, nv, m, rw.ip, rw.KK_r)
+    st = _band_lu(rw.KK_r, nv + m, rw.piv_r, rw.band[:2])
+    if st != _p.OK:
+        return st
+    _assemble(mc, rw.Mden, rw.K, rw.D, rw.Gd, nv, m, rw.ip, rw.KK_c)
+    st = _band_lu(rw.KK_c, nv + m, rw.piv_c, rw.band[2:])
+    counters[C_FACT] += 2
+    return st
+
+
+MU_COMPLEX_RE, MU_COMPLEX_IM = float(MU_COMPLEX.real), float(MU_COMPLEX.imag)
+T_ = np.ascontiguousarray(T)
+TI_ = np.ascontiguousarray(TI)
+C_ = np.ascontiguousarray(RADAU_C)
+E_ = np.ascontiguousarray(RADAU_E)
+
+
+@_inline
+def _rms_scaled(x, scale, rows):
+    acc = 0.0
+    n = scale.shape[0]
+    for r in range(rows):
+        for i in range(n):
+            z = x[r, i] / scale[i]
+            acc += z * z
+    return np.sqrt(acc / (rows * n))
+
+
+@_jit
+def _solve_real(lay, q, rw, h, nv, m, alpha, beta, r, out):
+    """``out = ((μ_r/h) I − J)⁻¹ r`` (y-space vectors)."""
+    nq = lay[4]
+    for i in range(nq):
+        rw.rq[i] = r[i]
+    for i in range(nv):
+        rw.rv[i] = r[nq + i]
+    _newton_solve(lay, q, MU_REAL / h, rw.Mden, rw.K, rw.Gd, nv, m, alpha, beta, rw.KK_r, rw.piv_r, rw.band[:2],
+                  rw.ip, rw.rq, rw.rv, rw.dq, rw.dv, rw.b, rw.wv)
+    for i in range(nq):
+        out[i] = rw.dq[i]
+    for i in range(nv):
+        out[nq + i] = rw.dv[i]
+
+
+@_jit
+def _collocation(cd, states, ws, rw, lay, nq, constrained, t, y, h, alpha, beta, tol, nv, m, counters, lam):
+    """RADAU5's simplified Newton iteration for the stages; returns (converged, iterations, rate)."""
+    Z, W, F, dW, yt, scale = rw.Z, rw.W, rw.F, rw.dW, rw.yt, rw.scale
+    n = y.shape[0]
+    q0 = y[:nq]
+    mr = MU_REAL / h
+    mc = (MU_COMPLEX_RE + 1j * MU_COMPLEX_IM) / h
+    # W = TI Z
+    for r in range(3):
+        for i in range(n):
+            W[r, i] = TI_[r, 0] * Z[0, i] + TI_[r, 1] * Z[1, i] + TI_[r, 2] * Z[2, i]
+    dW_norm_old = -1.0
+    rate = -1.0
+    converged = False
+    k = 0
+    rq_c, rv_c, dq_c, dv_c = rw.rq_c, rw.rv_c, rw.dq_c, rw.dv_c
+    for k in range(NEWTON_MAXITER):
+        finite = True
+        for i in range(3):
+            for j in range(n):
+                yt[j] = y[j] + Z[i, j]
+            st = _rhs(cd, states, ws, lay, nq, constrained, t + C_[i] * h, yt, alpha, beta, F[i], lam, counters)
+            if st != _p.OK and st != _p.NONFINITE:
+                return -st, k + 1, rate
+            for j in range(n):
+                if not np.isfinite(F[i, j]):
+                    finite = False
+        if not finite:
+            break
+        counters[C_NEWTON] += 1
+        # f_real = Fᵀ TI_real − (μ_r/h) W0 ;  f_complex = Fᵀ TI_complex − (μ_c/h)(W1 + i W2)
+        for j in range(n):
+            fr = TI_[0, 0] * F[0, j] + TI_[0, 1] * F[1, j] + TI_[0, 2] * F[2, j] - mr * W[0, j]
+            fc = ((TI_[1, 0] + 1j * TI_[2, 0]) * F[0, j] + (TI_[1, 1] + 1j * TI_[2, 1]) * F[1, j]
+                  + (TI_[1, 2] + 1j * TI_[2, 2]) * F[2, j] - mc * (W[1, j] + 1j * W[2, j]))
+            rw.tmp[j] = fr
+            if j < nq:
+                rq_c[j] = fc
+            else:
+                rv_c[j - nq] = fc
+        _solve_real(lay, q0, rw, h, nv, m, alpha, beta, rw.tmp, rw.err)
+        _newton_solve(lay, q0, mc, rw.Mden, rw.K, rw.Gd, nv, m, alpha, beta, rw.KK_c, rw.piv_c, rw.band[2:],
+                      rw.ip, rq_c, rv_c, dq_c, dv_c, rw.b_c, rw.wv_c)
+        for j in range(n):
+            dW[0, j] = rw.err[j]
+            c = dq_c[j] if j < nq else dv_c[j - nq]
+            dW[1, j] = c.real
+            dW[2, j] = c.imag
+        dW_norm = _rms_scaled(dW, scale, 3)
+        if dW_norm_old >= 0.0:
+            rate = dW_norm / dW_norm_old
+        if rate >= 0.0 and (rate >= 1.0 or rate ** (NEWTON_MAXITER - k) / (1.0 - rate) * dW_norm > tol):
+            break
+        for r in range(3):
+            for j in range(n):
+                W[r, j] += dW[r, j]
+        for r in range(3):
+            for j in range(n):
+                Z[r, j] = T_[r, 0] * W[0, j] + T_[r, 1] * W[1, j] + T_[r, 2] * W[2, j]
+        if dW_norm == 0.0 or (rate >= 0.0 and rate / (1.0 - rate) * dW_norm < tol):
+            converged = True
+            break
+        dW_norm_old = dW_norm
+    return 1 if converged else 0, k + 1, rate
+
+
+@_inline
+def _predict_factor(h_abs, h_abs_old, error_norm, error_norm_old):
+    if error_norm_old < 0.0 or h_abs_old < 0.0 or error_norm == 0.0:
+        multiplier = 1.0
+    else:
+        multiplier = h_abs / h_abs_old * (error_norm_old / error_norm) ** 0.25
+    if error_norm == 0.0:
+        return MAX_FACTOR
+    return min(1.0, multiplier) * error_norm ** -0.25
+
+
+@_jit
+def advance(cd, states, ws, rw, t, y, t_stop, t_bound, h_abs, max_steps, rtol, atol, max_step, newton_tol, alpha,
+            beta, projection, proj_tol, max_proj_iter, stateful, counters, info):
+    r"""Take accepted Radau steps from ``t`` until ``t ≥ t_stop`` (or ``max_steps``); state in place.
+
+    ``info = [t, h_abs, t_old, t_fail, h_abs_old, error_norm_old, have_jac, current_jac,
+    have_lu, h_lu]`` carries the controller's memory between calls; the last step's collocation
+    polynomial is left in ``rw.Qpoly`` and its start state in ``rw.y_old`` (dense output).
+    Returns an exit code: ``EXIT_REACHED``, ``EXIT_MAX_STEPS`` or a failure.
+    """
+    lay = cd.lay
+    nq = lay[4]
+    nv = lay[5]
+    m = cd.act.shape[0]
+    constrained = m > 0
+    n = y.shape[0]
+    lam = rw.lam
+    f = rw.f
+    Z = rw.Z
+    steps = 0
+    h_abs_old = info[4]
+    error_norm_old = info[5]
+    have_jac = info[6] != 0.0
+    current_jac = info[7] != 0.0
+    have_lu = info[8] != 0.0
+    h_lu = info[9]
+    while True:
+        if t >= t_stop:
+            break
+        if steps >= max_steps:
+            info[0] = t
+            info[1] = h_abs
+            info[4], info[5] = h_abs_old, error_norm_old
+            info[6], info[7], info[8], info[9] = have_jac, current_jac, have_lu, h_lu
+            return EXIT_MAX_STEPS
+        if not have_jac:
+            st = _jacobian(cd, states, ws, rw, t, y[:nq], y[nq:])
+            counters[C_JAC] += 1
+            if st != _p.OK:
+                info[0] = t
+                info[3] = t
+                return st
+            have_jac = True
+            current_jac = True
+            have_lu = False
+        min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+        if h_abs > max_step:
+            h_abs = max_step
+            h_abs_old = -1.0
+            error_norm_old = -1.0
+        elif h_abs < min_step:
+            h_abs = min_step
+            h_abs_old = -1.0
+            error_norm_old = -1.0
+        rejected = False
+        accepted = False
+        n_iter = 0
+        rate = -1.0
+        error_norm = 0.0
+        safety = 0.9
+        t_new = t
+        while not accepted:
+            if h_abs < min_step:
+                info[0] = t
+                info[3] = t
+                return EXIT_TOO_SMALL
+            t_new = t + h_abs
+            if t_new > t_bound:
+                t_new = t_bound
+            h = t_new - t
+            h_abs = abs(h)
+            # initial guess: the previous collocation polynomial extrapolated (zero at the start)
+            if info[2] == info[2] and steps + counters[C_STEPS] > 0:
+                h_prev = t - info[2]
+                for i in range(3):
+                    x = (t + RADAU_C_[i] * h - info[2]) / h_prev
+                    x1 = 1.0
+                    for j in range(n):
+                        Z[i, j] = 0.0
+                    for p in range(3):
+                        x1 = x1 * x
+                        for j in range(n):
+                            Z[i, j] += rw.Qpoly[j, p] * x1
+                    for j in range(n):
+                        Z[i, j] += rw.y_old[j] - y[j]
+            else:
+                for i in range(3):
+                    for j in range(n):
+                        Z[i, j] = 0.0
+            for j in range(n):
+                rw.scale[j] = atol + abs(y[j]) * rtol
+            converged = 0
+            while True:
+                if not have_lu or h_lu != h:
+                    st = _factor_both(rw, h, nv, m, counters)
+                    if st != _p.OK:
+                        info[0] = t
+                        info[3] = t
+                        return EXIT_SINGULAR_MATRIX
+                    have_lu = True
+                    h_lu = h
+                converged, n_iter, rate = _collocation(cd, states, ws, rw, lay, nq, constrained, t, y, h, alpha, beta,
+                                                       newton_tol, nv, m, counters, lam)
+                if converged < 0:  # a kernel failure other than non-finite values
+                    info[0] = t
+                    info[3] = t
+                    return -converged
+                if converged == 1 or current_jac:
+                    break
+                st = _jacobian(cd, states, ws, rw, t, y[:nq], y[nq:])
+                counters[C_JAC] += 1
+                if st != _p.OK:
+                    info[0] = t
+                    info[3] = t
+                    return st
+                current_jac = True
+                have_lu = False
+            if converged != 1:
+                h_abs *= 0.5
+                have_lu = False
+                rejected = True
+                counters[C_REJ] += 1
+                continue
+            for j in range(n):
+                rw.y_new[j] = y[j] + Z[2, j]
+            # error estimate: (μ_r/h − J)⁻¹ (f + Σ e_i Z_i / h)
+            for j in range(n):
+                rw.tmp[j] = f[j] + (E_[0] * Z[0, j] + E_[1] * Z[1, j] + E_[2] * Z[2, j]) / h
+            _solve_real(lay, y[:nq], rw, h, nv, m, alpha, beta, rw.tmp, rw.err)
+            for j in range(n):
+                rw.scale[j] = atol + max(abs(y[j]), abs(rw.y_new[j])) * rtol
+            acc = 0.0
+            for j in range(n):
+                z = rw.err[j] / rw.scale[j]
+                acc += z * z
+            error_norm = np.sqrt(acc / n)
+            safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter)
+            if rejected and error_norm > 1.0:
+                for j in range(n):
+                    rw.yt[j] = y[j] + rw.err[j]
+                _rhs(cd, states, ws, lay, nq, constrained, t, rw.yt, alpha, beta, rw.F[0], lam, counters)
+                for j in range(n):
+                    rw.tmp[j] = rw.F[0, j] + (E_[0] * Z[0, j] + E_[1] * Z[1, j] + E_[2] * Z[2, j]) / h
+                _solve_real(lay, y[:nq], rw, h, nv, m, alpha, beta, rw.tmp, rw.err)
+                acc = 0.0
+                for j in range(n):
+                    z = rw.err[j] / rw.scale[j]
+                    acc += z * z
+                error_norm = np.sqrt(acc / n)
+            if not error_norm == error_norm:
+                error_norm = np.inf
+            if error_norm > 1.0:
+                factor = _predict_factor(h_abs, h_abs_old, error_norm, error_norm_old)
+                h_abs *= max(MIN_FACTOR, safety * factor)
+                have_lu = False
+                rejected = True
+                counters[C_REJ] += 1
+            else:
+                accepted = True
+        # accepted
+        recompute_jac = n_iter > 2 and rate > 1e-3
+        factor = _predict_factor(h_abs, h_abs_old, error_norm, error_norm_old)
+        factor = min(MAX_FACTOR, safety * factor)
+        if rejected:
+            factor = min(1.0, factor)
+        if not recompute_jac and factor < 1.2:
+            factor = 1.0
+        # dense output polynomial (Q = Zᵀ P) and the start state of the step
+        for j in range(n):
+            rw.y_old[j] = y[j]
+            for p in range(3):
+                rw.Qpoly[j, p] = Z[0, j] * P_[0, p] + Z[1, j] * P_[1, p] + Z[2, j] * P_[2, p]
+        info[2] = t
+        for j in range(n):
+            y[j] = rw.y_new[j]
+        if projection:
+            it = _d.project(cd, ws, t_new, y[:nq], y[nq:], proj_tol, max_proj_iter, counters)
+            if it < 0:
+                for j in range(n):
+                    y[j] = rw.y_old[j]
+                info[0] = t
+                info[3] = t_new
+                return _p.PROJECTION
+        if stateful:
+            st = _d.accept(cd, states, ws, t_new, y[:nq], y[nq:])
+            if st != _p.OK:
+                info[0] = t
+                info[3] = t_new
+                return st
+        st = _rhs(cd, states, ws, lay, nq, constrained, t_new, y, alpha, beta, f, lam, counters)
+        if st != _p.OK and st != _p.NONFINITE:
+            info[0] = t
+            info[3] = t_new
+            return st
+        h_abs_old = h_abs
+        error_norm_old = error_norm
+        h_abs = h_abs * factor
+        t = t_new
+        steps += 1
+        counters[C_STEPS] += 1
+        if recompute_jac:
+            st = _jacobian(cd, states, ws, rw, t, y[:nq], y[nq:])
+            counters[C_JAC] += 1
+            if st != _p.OK:
+                info[0] = t
+                info[3] = t
+                return st
+            current_jac = True
+            have_lu = False
+        else:
+            current_jac = False
+    info[0] = t
+    info[1] = h_abs
+    info[4], info[5] = h_abs_old, error_norm_old
+    info[6], info[7], info[8], info[9] = have_jac, current_jac, have_lu, h_lu
+    return EXIT_REACHED
+
+
+P_ = np.ascontiguousarray(P)
+RADAU_C_ = C_
+
+
+class CompiledRadau(Integrator):
+    """Radau IIA (order 5) on the index-1 formulation in a compiled loop (see the module docstring).
+
+    Parameters
+    ----------
+    alpha, beta : float, optional
+        Baumgarte parameters [1/s] (``-baumgarte`` variant); default 10 each.
+    projection_tol : float, optional
+        Position-projection tolerance on ``‖Φ‖∞`` (``-projection`` variant); default ``atol``.
+    max_projection_iter : int, optional
+        Gauss–Newton iterations per projection (default 10).
+
+    Raises
+    ------
+    core.errors.NotCompilable
+        When the model has an element without a compiled kernel (the message names it).
+    """
+
+    stabilization = "none"
+    #: steps are taken up to the next output time (or past it); the collocation polynomial
+    #: gives the output in between
+    steps_to_output = True
+
+    @classmethod
+    def accepted_options(cls):
+        if cls.stabilization == "baumgarte":
+            return ("alpha", "beta")
+        if cls.stabilization == "projection":
+            return ("projection_tol", "max_projection_iter")
+        return ()
+
+    @classmethod
+    def applicable(cls, system):
+        try:
+            _l.compile_model(system)
+        except NotCompilable as exc:
+            return str(exc)
+        return None
+
+    def __init__(self, system, t_span, q0=None, v0=None, **kw):
+        super().__init__(system, t_span, q0, v0, **kw)
+        o = self.options
+        self._cm = cm = _l.compile_model(system)
+        self._cd = cm.data
+        self._states = cm.initial_states()
+        self._ws = _d.make_workspace(cm)
+        self.alpha = self.beta = 0.0
+        if self.stabilization == "baumgarte":
+            self.alpha = float(o.get("alpha", DEFAULT_BAUMGARTE))
+            self.beta = float(o.get("beta", DEFAULT_BAUMGARTE))
+            if not (self.alpha >= 0 and np.isfinite(self.beta)):
+                raise InputError(f"{self.name}: Baumgarte alpha must be ≥ 0 and beta finite, got {self.alpha}, {self.beta}")
+        self.projection_tol = float(o.get("projection_tol", self.atol))
+        self.max_projection_iter = int(o.get("max_projection_iter", 10))
+        if not self.projection_tol > 0:
+            raise InputError(f"{self.name}: projection_tol must be > 0, got {self.projection_tol}")
+        self.newton_tol = max(10 * np.finfo(float).eps / self.rtol, min(0.03, self.rtol ** 0.5))
+        nq, nv, m = system.n_q, system.n_v, cm.m
+        n = nq + nv
+        N = nv + m
+        Mden = system.M(self.t, self.q)
+        Mden = Mden.toarray() if sp.issparse(Mden) else np.asarray(Mden, float)
+        self._rw = RadauWork(
+            Mden=np.ascontiguousarray(Mden), K=np.zeros((nv, nv)), D=np.zeros((nv, nv)), Gd=np.zeros((max(m, 1), nv)),
+            KK_r=np.zeros((N, N)), KK_c=np.zeros((N, N), complex), piv_r=np.zeros(N, np.int64),
+            piv_c=np.zeros(N, np.int64), band=np.zeros(4, np.int64), ip=self._ordering(system, Mden, N),
+            f=np.zeros(n), y_new=np.zeros(n), y_old=np.zeros(n), Z=np.zeros((3, n)), W=np.zeros((3, n)),
+            F=np.zeros((3, n)), dW=np.zeros((3, n)), Zt=np.zeros((3, n)), yt=np.zeros(n), scale=np.zeros(n),
+            rq_c=np.zeros(nq, complex), rv_c=np.zeros(nv, complex), dq_c=np.zeros(nq, complex),
+            dv_c=np.zeros(nv, complex), b_c=np.zeros(N, complex), wv_c=np.zeros(nv, complex),
+            rq=np.zeros(nq), rv=np.zeros(nv), dq=np.zeros(nq), dv=np.zeros(nv), b=np.zeros(N), wv=np.zeros(nv),
+            err=np.zeros(n), tmp=np.zeros(n), qp=np.zeros(nq), vp=np.zeros(nv), Qa=np.zeros(nv), Qb=np.zeros(nv),
+            lam=np.zeros(max(m, 1)), Qpoly=np.zeros((n, 3)), info=np.zeros(10),
+        )
+        self._cnt = np.zeros(9, np.int64)
+        self._info = np.zeros(10)
+        self._info[2] = np.nan  # no previous step
+        self._info[4:6] = -1.0
+        self._y = np.concatenate([self.q, self.v])
+        if self.stabilization == "projection":
+            it = _d.project(self._cd, self._ws, self.t, self._y[:nq], self._y[nq:], self.projection_tol,
+                            self.max_projection_iter, self._cnt)
+            if it < 0:
+                raise InputError(f"{self.name}: initial state of {system.name!r} cannot be projected onto the constraints")
+        st = self._evaluate(self.t, self._y, self._rw.f)
+        if st != _p.OK:
+            raise InputError(f"{self.name}: right-hand side fails at the initial state of {system.name!r}: "
+                             f"{self._status_message(st)}")
+        self._h_abs = min(self.h, self.t_bound - self.t) if self.h is not None else self._initial_step()
+        self._corr = None
+        self._sync()
+
+    # --- set-up ---------------------------------------------------------------------------------
+    def _ordering(self, system, Mden, N):
+        """Reverse Cuthill–McKee positions of the (n_v + m) unknowns of the iteration matrices.
+
+        Pattern: the mass matrix, ``Φ_q`` and the force Jacobians at the initial state and at a
+        randomly perturbed one (so that couplings through elements that are unloaded at ``t0``,
+        e.g. an open contact, still shape the order; the LU takes the actual band each time).
+        """
+        nv = system.n_v
+        cm, cd = self._cm, self._cd
+        ws = _d.make_workspace(cm)
+        st = cm.initial_states()
+        K, D = np.zeros((nv, nv)), np.zeros((nv, nv))
+        pat = (np.abs(Mden) > 0).astype(float)
+        rng = np.random.default_rng(0)
+        work = (np.zeros(system.n_q), np.zeros(nv), np.zeros(nv), np.zeros(nv))
+        for q, v in ((self.q.copy(), self.v.copy()),
+                     (system.retract(self.q, 1e-3 * rng.standard_normal(nv)), rng.standard_normal(nv))):
+            if _d.force_jacobian(cd, st, ws, self.t, np.ascontiguousarray(q), np.ascontiguousarray(v), K, D,
+                                 *work) == _p.OK:
+                pat += (np.abs(K) + np.abs(D) > 0)
+        full = np.zeros((N, N))
+        full[:nv, :nv] = pat
+        if cm.m:
+            J = system.Phi_q(self.t, self.q)
+            J = (J.toarray() if sp.issparse(J) else np.asarray(J)) != 0
+            full[nv:, :nv] = J
+            full[:nv, nv:] = J.T
+        full += np.eye(N)
+        order = np.asarray(reverse_cuthill_mckee(sp.csr_matrix(full), symmetric_mode=True), np.int64)
+        ip = np.empty(N, np.int64)
+        ip[order] = np.arange(N)
+        return ip
+
+    def _evaluate(self, t, y, out):
+        """``out = F(t, y)`` with the compiled right-hand side; kernel status code."""
+        return int(_eval_rhs(self._cd, self._states, self._ws, float(t), y, self.alpha, self.beta, out, self._rw.lam,
+                             self._cnt))
+
+    def _status_message(self, code) -> str:
+        why = _p.STATUS_MESSAGES.get(code, f"kernel status {code}")
+        err = self._ws.err
+        if code not in (_p.SINGULAR, _p.NONFINITE, _p.PROJECTION) and err[2] in (1, 2):
+            family = "force" if err[2] == 1 else "constraint"
+            why = f"{self._cm.element_name(family, int(err[0]), int(err[1]))}: {why}"
+        return why
+
+    def _initial_step(self):
+        """Initial step of Hairer, Nørsett & Wanner I, Sec. II.4 for order 3 (scipy's Radau)."""
+        t0, y0, f0 = self.t, self._y, self._rw.f
+        interval = abs(self.t_bound - t0)
+        scale = self.atol + np.abs(y0) * self.rtol
+        d0 = float(np.sqrt(np.mean((y0 / scale) ** 2)))
+        d1 = float(np.sqrt(np.mean((f0 / scale) ** 2)))
+        h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+        h0 = min(h0, interval)
+        f1 = np.zeros_like(y0)
+        if self._evaluate(t0 + h0, y0 + h0 * f0, f1) != _p.OK:
+            f1[:] = np.nan
+        d2 = float(np.sqrt(np.mean(((f1 - f0) / scale) ** 2))) / h0
+        if d1 <= 1e-15 and d2 <= 1e-15:
+            h1 = max(1e-6, h0 * 1e-3)
+        else:
+            h1 = (0.01 / max(d1, d2)) ** (1.0 / 4)
+        h = min(100.0 * h0, h1, interval, self.max_step)
+        if not np.isfinite(h) or h <= 0:
+            raise InputError(f"{self.name}: no usable initial step at t = {t0:g} s for {self.system.name!r} "
+                             "(non-finite right-hand side near the initial state)")
+        return h
+
+    def _sync(self):
+        c, k = self.counters, self._cnt
+        c["n_rejected"] = int(k[C_REJ])
+        c["n_rhs"] = int(k[C_RHS])
+        c["n_factor"] = int(k[C_FACT])
+        c["n_jac"] = int(k[C_JAC])
+        c["n_newton"] = int(k[C_NEWTON])
+        nq = self.system.n_q
+        self.q, self.v = self._y[:nq].copy(), self._y[nq:].copy()
+        self.a = self._rw.f[nq:].copy()
+
+    # --- stepping -------------------------------------------------------------------------------
+    def advance(self, t_target: float, max_steps: int = 2**62) -> str | None:
+        """Take steps until ``t ≥ min(t_target, t_end)`` (the last may pass ``t_target``; the dense
+        output covers it); return the failure message or None."""
+        if self.status != STATUS_RUNNING:
+            raise RuntimeError(f"{self.name}: advance() called on a {self.status} integrator")
+        t_stop = min(float(t_target), self.t_bound)
+        if t_stop <= self.t:
+            return None
+        steps0 = int(self._cnt[C_STEPS])
+        info = self._info
+        t_before = self.t
+        code = advance(self._cd, self._states, self._ws, self._rw, self.t, self._y, t_stop, self.t_bound,
+                       self._h_abs, max_steps, self.rtol, self.atol, self.max_step, self.newton_tol, self.alpha,
+                       self.beta, self.stabilization == "projection", self.projection_tol, self.max_projection_iter,
+                       self._cm.stateful, self._cnt, info)
+        taken = int(self._cnt[C_STEPS]) - steps0
+        self.counters["n_steps"] += taken
+        nq = self.system.n_q
+        if taken:
+            rw = self._rw
+            self.t_old = float(info[2])
+            self.q_old, self.v_old = rw.y_old[:nq].copy(), rw.y_old[nq:].copy()
+            # the collocation polynomial of the last step, corrected by the projection at its end
+            h = float(info[0]) - self.t_old
+            x = np.array([1.0, 1.0, 1.0])
+            end = rw.y_old + rw.Qpoly @ x
+            self._corr = (self.t_old, float(info[0]), rw.y_old.copy(), rw.Qpoly.copy(), self._y - end, h)
+        self.t = float(info[0]) if code in (EXIT_REACHED, EXIT_MAX_STEPS) else float(info[0])
+        self._h_abs = float(info[1]) if info[1] > 0 else self._h_abs
+        self._sync()
+        if code in (EXIT_REACHED, EXIT_MAX_STEPS):
+            if self.t >= self.t_bound - 1e-12 * max(1.0, abs(self.t_bound)):
+                self.t = self.t_bound
+                self.status = STATUS_FINISHED
+                self.message = "reached the end of the time span"
+            return None
+        if code == EXIT_TOO_SMALL:
+            why = (f"step size fell below 10 ulp(t) at t = {info[3]:.6g} s (the Newton iteration does not converge "
+                   "or the stages are not finite at any step size)")
+        elif code == EXIT_SINGULAR_MATRIX:
+            why = (f"the Radau iteration matrix is singular at t = {info[3]:.6g} s (dependent constraints or a "
+                   "singular configuration)")
+        elif code == _p.PROJECTION:
+            why = (f"coordinate projection did not reach ‖Φ‖ ≤ {self.projection_tol:g} in "
+                   f"{self.max_projection_iter} iterations at t = {info[3]:.6g} s")
+        else:
+            why = f"{self._status_message(code)} at t = {info[3]:.6g} s"
+        self.status = STATUS_FAILED
+        self.t = max(t_before, self.t)
+        self.message = f"{self.name} failed at t = {self.t:.6g} s: {why}"
+        return self.message
+
+    def step(self) -> str | None:
+        """One accepted step (the :class:`Integrator` contract)."""
+        return self.advance(self.t_bound, max_steps=1)
+
+    def _step_impl(self):  # pragma: no cover - step() is overridden
+        raise NotImplementedError
+
+    def _dense_output_impl(self):
+        t0, t1, y0, Qp, corr, h = self._corr
+        nq = self.system.n_q
+        sys_ = self.system
+
+        def f(t):
+            x = 0.0 if h <= 0 else (t - t0) / h
+            y = y0 + Qp @ np.array([x, x * x, x ** 3]) + x * corr
+            return sys_.normalize(y[:nq].copy()), y[nq:].copy()
+
+        return f
+
+
+@_jit
+def _eval_rhs(cd, states, ws, t, y, alpha, beta, out, lam, counters):
+    lay = cd.lay
+    return _rhs(cd, states, ws, lay, lay[4], cd.act.shape[0] > 0, t, y, alpha, beta, out, lam, counters)
+
+
+def _make_class(stab: str) -> type[CompiledRadau]:
+    name = "jit-radau" + ("" if stab == "none" else f"-{stab}")
+    label = {"none": "unstabilised", "baumgarte": "Baumgarte-stabilised", "projection": "with coordinate projection"}[stab]
+    cls_name = "CompiledRadau" + {"none": "", "baumgarte": "Baumgarte", "projection": "Projection"}[stab]
+    doc = (f"Index-1 formulation ({label}) on a compiled Radau IIA (order 5) loop for stiff problems.\n\n"
+           f"Registry name ``{name!r}``.  See :mod:`core.integrators.compiled_radau` and :class:`CompiledRadau`.\n")
+    cls = type(cls_name, (CompiledRadau,), dict(
+        name=name, summary=f"index-1 {label}, compiled Radau IIA order 5 (stiff; numba)", stabilization=stab,
+        __doc__=doc, __module__=__name__))
+    return register(cls)
+
+
+RADAU_METHODS: dict[str, type[CompiledRadau]] = {}
+for _stab in ("none", "baumgarte", "projection"):
+    _cls = _make_class(_stab)
+    RADAU_METHODS[_cls.name] = _cls
+    globals()[_cls.__name__] = _cls
+del _stab, _cls

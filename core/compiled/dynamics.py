@@ -34,10 +34,10 @@ parameter rates).
 
 from __future__ import annotations
 
-from collections import namedtuple
-
 import numba
 import numpy as np
+from numba.core import types
+from numba.experimental import structref
 
 from .protocol import MAX_SLOTS, NONFINITE, OK, SINGULAR, WANT_GAMMA, WANT_NU, WANT_PHI
 
@@ -52,14 +52,45 @@ _inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="alwa
 PIVOT_RTOL = 1e-12
 FAMILY_FORCE, FAMILY_CONSTRAINT = 1, 2
 
-Workspace = namedtuple("Workspace", [
+WORKSPACE_FIELDS = (
     "r", "A", "rd", "w",           # body states (n_b + 1, 3 / 3×3)
     "phi", "G", "nu", "gam",       # constraint rows (m_all; G (m_all, MAX_SLOTS, 6))
     "X",                           # M⁻¹ Φ_qᵀ blocks (m_all, MAX_SLOTS, 6)
     "S", "L", "rhs",               # Schur complement, envelope factor, right-hand side (m_R)
     "C", "W", "T", "piv", "z",     # border: C (m_R, n_z), W = S⁻¹C, T (n_z, n_z) LU, pivots, z (n_z)
     "Q", "g", "mu", "tmp_v", "tmp_v2", "err",
-])
+)
+
+
+@structref.register
+class WorkspaceType(types.StructRef):
+    """numba type of :class:`Workspace`."""
+
+    def preprocess_fields(self, fields):
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)
+
+
+class Workspace(structref.StructRefProxy):
+    """Scratch arrays of the compiled equations (fields :data:`WORKSPACE_FIELDS`).
+
+    A numba structref, passed into compiled functions as a pointer: a tuple of ~20 arrays would be
+    copied at every call of a compiled function that takes it.  From Python the fields read as
+    the same numpy arrays (shared memory).
+    """
+
+    def __new__(cls, *values):
+        obj = structref.StructRefProxy.__new__(cls, *values)
+        obj._arrays = dict(zip(WORKSPACE_FIELDS, values))
+        return obj
+
+    def __getattr__(self, name):
+        try:
+            return self.__dict__["_arrays"][name]
+        except KeyError:
+            raise AttributeError(f"Workspace has no field {name!r}") from None
+
+
+structref.define_proxy(Workspace, WorkspaceType, list(WORKSPACE_FIELDS))
 
 
 def make_workspace(cm) -> Workspace:
@@ -70,7 +101,7 @@ def make_workspace(cm) -> Workspace:
     A = np.zeros((nb + 1, 3, 3))
     A[:, 2, 2] = 1.0  # planar bodies rotate about z (body_states writes the 2×2 block)
     A[nb] = np.eye(3)
-    return Workspace(
+    fields = dict(
         r=np.zeros((nb + 1, 3)), A=A, rd=np.zeros((nb + 1, 3)), w=np.zeros((nb + 1, 3)),
         phi=np.zeros(m_all), G=np.zeros((m_all, MAX_SLOTS, 6)), nu=np.zeros(m_all), gam=np.zeros(m_all),
         X=np.zeros((m_all, MAX_SLOTS, 6)),
@@ -80,6 +111,7 @@ def make_workspace(cm) -> Workspace:
         Q=np.zeros(n_v), g=np.zeros(m_all), mu=np.zeros(m_all), tmp_v=np.zeros(n_v), tmp_v2=np.zeros(n_v),
         err=np.zeros(3, np.int64),
     )
+    return Workspace(*(fields[f] for f in WORKSPACE_FIELDS))
 
 
 # ================================================================================================
@@ -336,10 +368,14 @@ def _minv_times_row(minv, b, wdt, G, X, a, sl):
 def factor(cd, ws):
     """``X = M⁻¹Φ_qᵀ`` blocks, ``S`` of the regular rows with its envelope Cholesky factor, and the
     border ``C``, ``W = S⁻¹C``, ``T`` with its LU (:mod:`core.compiled.layout`); status code."""
-    reg, first, r_blk, blk_x, blk_w, minv, pat, ext = (cd.reg, cd.env_first, cd.r_blk, cd.blk_x, cd.blk_w, cd.minv,
-                                                       cd.pat, cd.ext)
-    rs_cnt, rs = cd.rs_cnt, cd.rs
-    S, L, G, X = ws.S, ws.L, ws.G, ws.X
+    return _factor(cd.reg, cd.env_first, cd.r_blk, cd.blk_x, cd.blk_w, cd.minv, cd.pat, cd.ext, cd.rs_cnt, cd.rs,
+                   cd.n_x, cd.xm, cd.hpat, cd.epat, ws.S, ws.L, ws.G, ws.X, ws.C, ws.W, ws.T, ws.piv)
+
+
+@_inline
+def _factor(reg, first, r_blk, blk_x, blk_w, minv, pat, ext, rs_cnt, rs, nx, xm, hpat, epat, S, L, G, X, C, W, T,
+            piv):
+    """:func:`factor` on arrays (inlined where the caller has loaded them once)."""
     m = reg.shape[0]
     ne = ext.shape[0]
     for k in range(m + ne):
@@ -370,11 +406,9 @@ def factor(cd, ws):
                 L[i, i] = np.sqrt(s)
             else:
                 L[i, j] = s / L[j, j]
-    nx = cd.n_x
     nz = nx + ne
     if nz == 0:
         return OK
-    C, W, T, xm, hpat, epat = ws.C, ws.W, ws.T, cd.xm, cd.hpat, cd.epat
     for k in range(m):
         for j in range(nz):
             C[k, j] = 0.0
@@ -418,7 +452,7 @@ def factor(cd, ws):
         for c in range(wdt):
             acc += G[a, sa, c] * X[b, sb, c]
         T[nx + epat[p, 4], nx + epat[p, 5]] -= acc
-    return _lu_factor(T, nz, ws.piv)
+    return _lu_factor(T, nz, piv)
 
 
 @_inline
@@ -489,10 +523,14 @@ def saddle_solve(cd, ws, f, g, x, mu):
 
     ``g`` and ``mu`` are indexed by model rows (``mu`` is written for the active rows).
     """
-    reg, first, blk_v0, blk_w, blk_x, minv, ext = (cd.reg, cd.env_first, cd.blk_v0, cd.blk_w, cd.blk_x, cd.minv,
-                                                   cd.ext)
-    rs_cnt, rs, mass_blocks = cd.rs_cnt, cd.rs, cd.mass_blocks
-    G, X, rhs, z = ws.G, ws.X, ws.rhs, ws.z
+    _saddle(cd.reg, cd.env_first, cd.blk_v0, cd.blk_w, cd.blk_x, cd.minv, cd.ext, cd.rs_cnt, cd.rs, cd.mass_blocks,
+            cd.n_x, ws.G, ws.X, ws.rhs, ws.z, ws.L, ws.C, ws.W, ws.T, ws.piv, f, g, x, mu)
+
+
+@_inline
+def _saddle(reg, first, blk_v0, blk_w, blk_x, minv, ext, rs_cnt, rs, mass_blocks, nx, G, X, rhs, z, L, C, W, T, piv,
+            f, g, x, mu):
+    """:func:`saddle_solve` on arrays (inlined where the caller has loaded them once)."""
     # x_B0 = M_B⁻¹ f_B
     for u in range(mass_blocks.shape[0]):
         b = mass_blocks[u]
@@ -507,12 +545,10 @@ def saddle_solve(cd, ws, f, g, x, mu):
             for c in range(wdt):
                 acc += G[a, sl, c] * x[o + c]
         rhs[k] = acc - g[a]
-    _solve_envelope(ws.L, first, m, rhs)
-    nx = cd.n_x
+    _solve_envelope(L, first, m, rhs)
     ne = ext.shape[0]
     nz = nx + ne
     if nz > 0:
-        C, W = ws.C, ws.W
         for b in range(blk_x.shape[0]):
             if blk_x[b] >= 0:
                 for c in range(blk_w[b]):
@@ -530,7 +566,7 @@ def saddle_solve(cd, ws, f, g, x, mu):
             for k in range(m):
                 acc += C[k, j] * rhs[k]
             z[j] += acc
-        _lu_solve(ws.T, nz, ws.piv, z)
+        _lu_solve(T, nz, piv, z)
         for k in range(m):
             acc = 0.0
             for j in range(nz):
@@ -596,17 +632,21 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
     st = constraints(cd, ws, t, q, v, flags)
     if st != OK:
         return st
-    st = factor(cd, ws)
+    reg, first, blk_x, ext, rs_cnt, rs, nx = cd.reg, cd.env_first, cd.blk_x, cd.ext, cd.rs_cnt, cd.rs, cd.n_x
+    G, X, S, L, C, W, T, piv = ws.G, ws.X, ws.S, ws.L, ws.C, ws.W, ws.T, ws.piv
+    st = _factor(reg, first, r_blk, blk_x, blk_w, minv, cd.pat, ext, rs_cnt, rs, nx, cd.xm, cd.hpat, cd.epat,
+                 S, L, G, X, C, W, T, piv)
     if st != OK:
         return st
-    g, gam, nu, phi, G, mu = ws.g, ws.gam, ws.nu, ws.phi, ws.G, ws.mu
+    g, gam, nu, phi, mu = ws.g, ws.gam, ws.nu, ws.phi, ws.mu
     for k in range(m):
         a = act[k]
         ga = gam[a]
         if baum:
             ga -= 2.0 * alpha * (_row_dot(r_blk, blk_v0, blk_w, G, a, v) - nu[a]) + beta * beta * phi[a]
         g[a] = ga
-    saddle_solve(cd, ws, Q, g, vdot, mu)
+    _saddle(reg, first, blk_v0, blk_w, blk_x, minv, ext, rs_cnt, rs, cd.mass_blocks, nx, G, X, ws.rhs, ws.z, L, C, W,
+            T, piv, Q, g, vdot, mu)
     for k in range(m):
         lam[k] = mu[act[k]]
     for i in range(vdot.shape[0]):

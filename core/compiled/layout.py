@@ -127,7 +127,15 @@ class CompiledData(structref.StructRefProxy):
     """
 
     def __new__(cls, *values):
-        return structref.StructRefProxy.__new__(cls, *values)
+        obj = structref.StructRefProxy.__new__(cls, *values)
+        obj._fields = dict(zip(MODEL_FIELDS + KERNEL_FIELDS, values))
+        return obj
+
+    def __getattr__(self, name):
+        try:
+            return self.__dict__["_fields"][name]
+        except KeyError:
+            raise AttributeError(f"CompiledData has no field {name!r}") from None
 
 
 structref.define_proxy(CompiledData, CompiledDataType, list(MODEL_FIELDS + KERNEL_FIELDS))

@@ -65,11 +65,11 @@ P. E. Nikravesh, *Computer-Aided Analysis of Mechanical Systems*, Prentice Hall,
 
 from __future__ import annotations
 
-from collections import namedtuple
-
 import numba
 import numpy as np
 import scipy.sparse as sp
+from numba.core import types
+from numba.experimental import structref
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
 from ..compiled import dynamics as _d
@@ -100,14 +100,41 @@ C_JAC, C_NEWTON = 7, 8
 EXIT_SINGULAR_MATRIX = 104
 
 #: Work arrays of the compiled Radau loop (allocated once per integrator).
-RadauWork = namedtuple("RadauWork", [
+RADAU_WORK_FIELDS = (
     "Mden", "K", "D", "Gd", "KK_r", "KK_c", "piv_r", "piv_c", "band",  # Jacobian and factors
     "ip",                                                               # RCM position of each unknown
     "f", "y_new", "y_old", "Z", "W", "F", "dW", "Zt", "yt", "scale",    # stages
     "rq_c", "rv_c", "dq_c", "dv_c", "b_c", "wv_c",                      # complex solve work
     "rq", "rv", "dq", "dv", "b", "wv", "err", "tmp", "qp", "vp", "Qa", "Qb", "lam",
     "Qpoly", "info",
-])
+)
+
+
+@structref.register
+class RadauWorkType(types.StructRef):
+    """numba type of :class:`RadauWork`."""
+
+    def preprocess_fields(self, fields):
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)
+
+
+class RadauWork(structref.StructRefProxy):
+    """The arrays of one Radau run (a structref: passed by pointer into the compiled functions;
+    from Python its fields read as the same numpy arrays)."""
+
+    def __new__(cls, **arrays):
+        obj = structref.StructRefProxy.__new__(cls, *(arrays[f] for f in RADAU_WORK_FIELDS))
+        obj._arrays = arrays
+        return obj
+
+    def __getattr__(self, name):
+        try:
+            return self.__dict__["_arrays"][name]
+        except KeyError:
+            raise AttributeError(f"RadauWork has no field {name!r}") from None
+
+
+structref.define_proxy(RadauWork, RadauWorkType, list(RADAU_WORK_FIELDS))
 
 
 # ================================================================================================

@@ -6,7 +6,7 @@ Commands::
     mbsuite run NAME [NAME ...] [-o OUT] [--fast]
     mbsuite run --all [-o OUT] [--fast]       every scene, into OUT/<scene name>/
     mbsuite bench [PROBLEM ...] [--methods M ...] [--repeats N] [--quick|--full] [-j N] [-o OUT]
-    mbsuite bench --list                      work-precision problems and methods (core.workprecision)
+    mbsuite bench --list                      work-precision problems and methods (core.benchmarks)
     mbsuite --version
 
 Domain packages add sub-commands through entry points in group
@@ -20,6 +20,7 @@ Exit codes: 0 success, 1 one or more scenes (or a plug-in command) failed, 2 usa
 from __future__ import annotations
 
 import argparse
+import fnmatch
 import importlib.metadata
 import sys
 import time
@@ -111,6 +112,79 @@ def _cmd_run(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from .benchmarks import (
+        PROBLEMS,
+        available_methods,
+        fastest_to_tolerance,
+        problem_sets,
+        run_problem_set,
+        write_work_precision,
+    )
+
+    if args.list:
+        sets = problem_sets()
+        width = max(len(n) for n in PROBLEMS)
+        for name, p in PROBLEMS.items():
+            tags = ",".join(s for s in ("quick", "standard") if name in sets[s]) or "-"
+            print(f"{name:<{width}}  [{tags}]  {p.title}")
+        print("\nsets: " + "; ".join(f"{k}: {len(v)} problems" for k, v in sets.items()))
+        print("methods: " + ", ".join(available_methods()))
+        return 0
+    grid = "quick" if args.quick else ("full" if args.full else "standard")
+    names = list(args.problems) or problem_sets()[grid]
+    expanded: list[str] = []
+    sets = problem_sets()
+    for n in names:
+        if n in sets:
+            expanded += sets[n]
+        elif n in PROBLEMS:
+            expanded.append(n)
+        else:
+            matches = [p for p in PROBLEMS if fnmatch.fnmatchcase(p, n)]
+            if not matches:
+                args._parser.error(f"unknown problem {n!r}; see `mbsuite bench --list`")
+            expanded += matches
+    expanded = list(dict.fromkeys(expanded))
+    methods = None
+    if args.methods:
+        methods = [m for item in args.methods for m in item.split(",") if m]
+        registry = available_methods()
+        unknown = [m for m in methods if m not in registry]
+        if unknown:
+            args._parser.error(f"unknown method(s) {unknown}; registered: {', '.join(registry)}")
+    start = time.perf_counter()
+    df = run_problem_set(expanded, grid, methods=methods, repeats=args.repeats, jobs=args.jobs, progress=True,
+                           report=lambda s: print(s, file=sys.stderr))
+    written = write_work_precision(df, args.out)
+    summary = fastest_to_tolerance(df)
+    print(summary.to_markdown(index=False, floatfmt=".3g"))
+    print(f"mbsuite bench: {len(df)} runs of {len(expanded)} problem(s) in {time.perf_counter() - start:.1f} s "
+          f"-> {args.out} ({len(written) - 1} tables + figures, summary)")
+    return 0
+
+
+def register_bench_command(subparsers) -> None:
+    """Add ``mbsuite bench`` (the work-precision harness of :mod:`core.benchmarks`) to an argparse
+    sub-parser collection; the package is imported only when the command runs."""
+    p = subparsers.add_parser(
+        "bench", help="work-precision benchmark: error vs run time of every integrator",
+        description=("Run benchmark problems with every integrator over tolerance / step-size grids and write "
+                     "<out>/wp_<problem>.csv/.md/.png and wp_summary.csv/.md. PROBLEM may be a problem name, a "
+                     "glob (chain*), or a set name (quick, standard, full); default: the standard set "
+                     "(--quick: the quick set)."))
+    p.add_argument("problems", nargs="*", metavar="PROBLEM", help="problem names, globs or sets (see --list)")
+    p.add_argument("--list", action="store_true", help="list problems, sets and registered methods")
+    p.add_argument("--methods", nargs="+", metavar="METHOD", help="integrator names (default: the grid's)")
+    p.add_argument("--repeats", type=int, default=3, help="solves per case; wall time = median (default 3)")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--quick", action="store_true", help="CI-sized grids (about a minute for the quick set)")
+    g.add_argument("--full", action="store_true", help="full grids: every method, rtol 1e-3..1e-10 (long)")
+    p.add_argument("-j", "--jobs", type=int, default=1, help="worker processes (default 1: serial)")
+    p.add_argument("-o", "--out", default="out/bench", help="output folder (default: %(default)s)")
+    p.set_defaults(func=_cmd_bench, _parser=p)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Build the argument parser, including sub-commands from plug-ins."""
     parser = argparse.ArgumentParser(
@@ -129,8 +203,6 @@ def build_parser() -> argparse.ArgumentParser:
     p_run.add_argument("-o", "--out", default="out", help="output folder (default: %(default)s)")
     p_run.add_argument("--fast", action="store_true", help="reduced resolution (smoke test)")
     p_run.set_defaults(func=_cmd_run, _parser=p_run)
-
-    from .workprecision import register_bench_command
 
     register_bench_command(sub)
 

@@ -13,7 +13,8 @@ import pandas as pd
 from scipy.special import ellipk
 
 from . import analysis, models, plot
-from .benchmark_problems import AndrewsSqueezer
+from .benchmarks.references import n_link_chain_reference
+from .benchmarks.testset import AndrewsSqueezer
 from .integrators import simulate
 from .scenes import Scene, SceneContext, SceneResult, register_scene
 
@@ -136,7 +137,7 @@ def _crank_geometry(model) -> tuple[float, float]:
 def _chain(ctx: SceneContext) -> SceneResult:
     """N-link whip chain (N = 8): integrators against the minimal-coordinate reference."""
     n = 4 if ctx.fast else 8
-    ref = models.n_link_chain_reference(n, 1.0)
+    ref = n_link_chain_reference(n, 1.0)
     tip_ref = np.asarray(ref["tip"] if isinstance(ref, dict) else ref[0])
     rows, last = [], None
     for planar in (True, False):
@@ -220,7 +221,7 @@ def _andrews(ctx: SceneContext) -> SceneResult:
     return SceneResult(
         tables={"andrews_at_0.03s": pd.DataFrame(rows)},
         figures={"violations": plot.plot_violations(res)},
-        notes="Reference: Test Set for IVP Solvers (Mazzia & Magherini), andrews.f; see core/benchmark_problems.py.",
+        notes="Reference: Test Set for IVP Solvers (Mazzia & Magherini), andrews.f; see core/benchmarks/testset.py.",
     )
 
 
@@ -241,8 +242,8 @@ for _s in SCENES:
     register_scene(_s)
 
 # the work-precision report is part of the main job (issue: "the README's main command includes
-# the work-precision report"); it lives in core.workprecision
-from .workprecision import work_precision_scenes  # noqa: E402
+# the work-precision report"); it lives in core.benchmarks.scenes
+from .benchmarks.scenes import work_precision_scenes  # noqa: E402
 
 for _s in work_precision_scenes():
     register_scene(_s)

@@ -16,11 +16,13 @@ function                               what it is / source
 :func:`four_bar`                       Grashof crank–rocker
 :func:`n_link_chain`                   the N-link whip chain of ``core_benchmarks.md`` §1
                                        (planar, spatial, or with point springs for joints)
-:func:`n_link_chain_reference`         its minimal-coordinate reference solution (DOP853)
 :func:`body_on_helix`                  a bead on a helix: a :class:`~core.joints.UserConstraint`
                                        with the helix parameter as an extra coordinate
 :func:`bouncing_ball`                  a sphere on the ground plane (PlaneContact)
 =====================================  ====================================================
+
+Their reference solutions (the chain's minimal-coordinate motion, the equivalent pendulum of
+IFToMM A02, ...) are in :mod:`core.benchmarks.references`.
 
 References
 ----------
@@ -38,9 +40,7 @@ J. E. Shigley, J. J. Uicker, *Theory of Machines and Mechanisms*, McGraw-Hill, 1
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 from numpy.typing import NDArray
-from scipy.integrate import solve_ivp
 
 from . import frames
 from .compiled.protocol import OK, WANT_GAMMA, WANT_NU, WANT_PHI, CompiledConstraints, body_slot, constraint_kernel
@@ -57,7 +57,6 @@ __all__ = [
     "slider_crank",
     "four_bar",
     "n_link_chain",
-    "n_link_chain_reference",
     "chain_tip",
     "body_on_helix",
     "bouncing_ball",
@@ -305,73 +304,6 @@ def chain_tip(model: Model, q: Array) -> Array:
         A = frames.euler_to_matrix(blk[:, 3:7])
         tip = blk[:, :2] + half * A[:, :2, 0]
     return tip[0] if single else tip
-
-
-def n_link_chain_reference(n: int, t_end: float = 1.0, t_eval=None, rtol: float = 1e-13, atol: float = 1e-13,
-                           total_length: float = 1.0, total_mass: float = 1.0, gravity: float = G_EARTH):
-    r"""Reference motion of the N-link chain in minimal coordinates (absolute link angles θ_k).
-
-    Equations (``core_benchmarks.md`` §1; Lagrange's equations of the chain)::
-
-        Σ_l B_kl cos(θ_k − θ_l) θ̈_l + Σ_l B_kl sin(θ_k − θ_l) θ̇_l² = −g cos θ_k Σ_i m a_ik
-        a_ik = L (k < i), L/2 (k = i), 0 (k > i),     B_kl = Σ_i m a_ik a_il + J δ_kl
-
-    integrated with scipy's DOP853 at ``rtol = atol = 1e−13``, from θ = 0, θ̇ = 0.  The tip is
-    ``Σ_k L (cos θ_k, sin θ_k)``.
-
-    Parameters
-    ----------
-    n : int
-    t_end : float
-        [s]
-    t_eval : array_like, optional
-        Output times [s] (default: 101 equally spaced).
-
-    Returns
-    -------
-    tip : ndarray, shape (2,)
-        Tip position (x, y) [m] at ``t_end``.
-    history : pandas.DataFrame
-        Columns ``t [s]``, ``theta_k [rad]``, ``omega_k [rad/s]`` (k = 1..N), ``tip x [m]``,
-        ``tip y [m]``.
-
-    Raises
-    ------
-    RuntimeError
-        If DOP853 does not reach ``t_end``.
-    """
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise ValueError(f"n_link_chain_reference: n must be an integer ≥ 1, got {n!r}")
-    L, m = total_length / n, total_mass / n
-    J = m * L * L / 12.0
-    idx = np.arange(n)
-    a = np.where(idx[None, :] < idx[:, None], L, 0.0) + np.where(idx[None, :] == idx[:, None], L / 2, 0.0)  # a[i, k]
-    B = m * a.T @ a + J * np.eye(n)
-    grav = gravity * m * a.sum(0)  # g Σ_i m a_ik
-
-    def rhs(t, y):
-        th, om = y[:n], y[n:]
-        D = th[:, None] - th[None, :]
-        Mth = B * np.cos(D)
-        f = -(B * np.sin(D)) @ (om * om) - grav * np.cos(th)
-        return np.concatenate([om, np.linalg.solve(Mth, f)])
-
-    t_eval = np.linspace(0.0, t_end, 101) if t_eval is None else np.asarray(t_eval, float)
-    sol = solve_ivp(rhs, (0.0, t_end), np.zeros(2 * n), method="DOP853", rtol=rtol, atol=atol, t_eval=t_eval,
-                    dense_output=True)
-    if sol.status != 0:
-        raise RuntimeError(f"n_link_chain_reference(n={n}): DOP853 failed: {sol.message}")
-    yend = sol.sol(t_end)
-    tip_end = L * np.array([np.cos(yend[:n]).sum(), np.sin(yend[:n]).sum()])
-    th = sol.y[:n].T
-    cols = {"t [s]": sol.t}
-    for k in range(n):
-        cols[f"theta_{k + 1} [rad]"] = th[:, k]
-    for k in range(n):
-        cols[f"omega_{k + 1} [rad/s]"] = sol.y[n + k]
-    cols["tip x [m]"] = L * np.cos(th).sum(1)
-    cols["tip y [m]"] = L * np.sin(th).sum(1)
-    return tip_end, pd.DataFrame(cols)
 
 
 # --------------------------------------------------------------------------------------------
@@ -804,14 +736,14 @@ def _andrews_points(q_angles, p):
 def andrews_cartesian(**overrides: float) -> Model:
     r"""Andrews' squeezing mechanism as a planar Cartesian model of seven rigid bodies.
 
-    The same mechanism as :class:`core.benchmark_problems.AndrewsSqueezer` (which is written in
+    The same mechanism as :class:`core.benchmarks.testset.AndrewsSqueezer` (which is written in
     the seven angles), built with :class:`~core.model.ModelBuilder` in absolute coordinates
     ``(x, y, θ)`` per body: 21 coordinates, ten revolute joints (20 equations), 1 degree of
     freedom.  Its solution must reach the same angles (:func:`andrews_angles_from_cartesian`).
 
     Geometry (Hairer & Wanner II, Sec. VII.7, Fig. 7.1 and Eqs. (7.11)–(7.14); test set
     ``andrews.f``), read off the angle-form constraints and mass matrix of
-    :class:`~core.benchmark_problems.AndrewsSqueezer`; ``e(α) = (cos α, sin α)``,
+    :class:`~core.benchmarks.testset.AndrewsSqueezer`; ``e(α) = (cos α, sin α)``,
     ``R(α)`` the rotation by α; fixed points O = (0, 0), A = (xa, ya), B = (xb, yb),
     C = (xc, yc):
 
@@ -849,7 +781,7 @@ def andrews_cartesian(**overrides: float) -> Model:
     Parameters
     ----------
     **overrides : float
-        Replace entries of :data:`core.benchmark_problems.ANDREWS_PARAMETERS` (SI units).
+        Replace entries of :data:`core.benchmarks.testset.ANDREWS_PARAMETERS` (SI units).
 
     Returns
     -------
@@ -863,7 +795,7 @@ def andrews_cartesian(**overrides: float) -> Model:
     W. Schiehlen (ed.), *Multibody Systems Handbook*, Springer, 1990 (Manning & Giles,
     Andrews & Richard: "seven body mechanism"); IFToMM benchmark A03.
     """
-    from .benchmark_problems import ANDREWS_PARAMETERS, AndrewsSqueezer
+    from .benchmarks.testset import ANDREWS_PARAMETERS, AndrewsSqueezer
     from .forces import AppliedTorque, SpringDamper
 
     unknown = set(overrides) - set(ANDREWS_PARAMETERS)
@@ -939,7 +871,7 @@ def iftomm_a02_four_bar_chain(n_windows: int = 40, link_length: float = 1.0, lin
     (clockwise) and every coupler translates at (1, 0) m/s.  Simulated for 20 s.
 
     Motion: the parallelograms keep all bars parallel, so the exact motion is that of one
-    equivalent pendulum in the bar angle φ (:func:`iftomm_a02_reference`)::
+    equivalent pendulum in the bar angle φ (:func:`core.benchmarks.references.iftomm_a02_reference`)::
 
         [ (N+1) m L²/3 + N m L² ] φ̈ = −g L cos φ [ (N+1) m/2 + N m ]
 
@@ -1007,30 +939,6 @@ def iftomm_a02_four_bar_chain(n_windows: int = 40, link_length: float = 1.0, lin
         if i < n_windows:
             b.add_revolute(f"B{i}/R", f"bar{i}", f"coupler{i + 1}", Bi)
     return b.build(redundant=redundant)
-
-
-def iftomm_a02_reference(t_eval, n_windows: int = 40, link_length: float = 1.0, speed: float = 1.0,
-                         angle0: float = np.pi / 2, gravity: float = G_EARTH, rtol: float = 1e-12,
-                         atol: float = 1e-12):
-    r"""Minimal-coordinate reference of :func:`iftomm_a02_four_bar_chain`: bar angle φ(t).
-
-    Equal masses m cancel: ``[(N+1)/3 + N] L φ̈ = −g cos φ [(N+1)/2 + N]`` (see the model
-    docstring), integrated with DOP853.  ``x(B_0) = L cos φ``, ``y(B_0) = L sin φ``.
-
-    Returns
-    -------
-    phi, phidot : ndarray, shape (n_t,)
-        [rad], [rad/s] at ``t_eval`` [s].
-    """
-    t_eval = np.asarray(t_eval, float)
-    N, L = int(n_windows), float(link_length)
-    c = gravity * ((N + 1) / 2 + N) / (L * ((N + 1) / 3 + N))
-    w0 = _a02_rate(float(angle0), float(speed), L)
-    sol = solve_ivp(lambda t, y: [y[1], -c * np.cos(y[0])], (0.0, float(t_eval[-1])), [float(angle0), w0],
-                    method="DOP853", rtol=rtol, atol=atol, t_eval=t_eval)
-    if sol.status != 0:
-        raise RuntimeError(f"iftomm_a02_reference: DOP853 failed: {sol.message}")
-    return sol.y[0], sol.y[1]
 
 
 # --------------------------------------------------------------------------------------------
@@ -1127,4 +1035,4 @@ def iftomm_a04_bricard(link_length: float = 1.0, link_mass: float = 1.0, cross_s
 
 
 __all__ += ["andrews_cartesian", "andrews_angles_from_cartesian", "iftomm_a02_four_bar_chain",
-            "iftomm_a02_reference", "iftomm_a04_bricard", "BRICARD_JOINTS"]
+            "iftomm_a04_bricard", "BRICARD_JOINTS"]

@@ -232,6 +232,8 @@ class CompiledModel:
         self.n_b = int(fields["lay"][0])
         self.n_q, self.n_v = int(fields["lay"][4]), int(fields["lay"][5])
         self.stateful = bool(np.any(fields["frc_stateful"]))
+        #: set-up results of integrators kept with the model (e.g. the Radau unknowns' ordering)
+        self.setup_cache: dict = {}
 
     def initial_states(self) -> np.ndarray:
         """A fresh copy of the force kinds' search states (one per integrator run), stored flat

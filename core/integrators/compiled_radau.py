@@ -42,10 +42,13 @@ otherwise) and ``Z⁺`` the map of coordinate increments to velocity-space incre
 the stiff force terms and the constraints exactly and drops the derivatives of ``Φ_q``, ``γ`` and
 the gyroscopic-free inertia terms, which are smooth: a simplified Newton iteration converges with
 it (the residual is exact), and the Jacobian is refreshed when the iteration slows (RADAU5's rule).
-The ``(n_v + m)`` matrices are assembled in reverse Cuthill–McKee order and factorised by banded LU
-with partial pivoting (Golub & Van Loan 2013, Alg. 4.3.5), real and complex, and the factors are
-reused over the steps in which the step size and the Jacobian stay unchanged (RADAU5 keeps the
-step when the predicted change is below 20 %).
+The ``(n_v + m)`` matrices are assembled in reverse Cuthill–McKee order from the sparse rows of
+``M``, ``K``, ``D`` and ``Φ_q`` (packed once per Jacobian, with the band they span) and factorised
+by banded LU with partial pivoting (Golub & Van Loan 2013, Alg. 4.3.5), real and complex, and the
+factors are reused over the steps in which the step size and the Jacobian stay unchanged (RADAU5
+keeps the step when the predicted change is below 20 %).  When the iteration fails with an old
+Jacobian, it restarts from the same starting guess with a fresh one; when it fails with a fresh
+one, the step is halved (RADAU5).
 
 Error control is RADAU5's (estimate ``(γ₀/h − J)⁻¹ (f(y₀) + Σ eᵢ Zᵢ / h)``, norm
 ``‖e / (atol + rtol |y|)‖_RMS``); there is no stability limit and so no stiffness warning.
@@ -102,6 +105,7 @@ EXIT_SINGULAR_MATRIX = 104
 #: Work arrays of the compiled Radau loop (allocated once per integrator).
 RADAU_WORK_FIELDS = (
     "Mden", "K", "D", "Gd", "KK_r", "KK_c", "piv_r", "piv_c", "band",  # Jacobian and factors
+    "sp_ptr", "sp_col", "sp_m", "sp_k", "sp_d", "g_ptr", "g_col", "g_val",  # their sparse rows
     "ip",                                                               # RCM position of each unknown
     "f", "y_new", "y_old", "Z", "W", "F", "dW", "Zt", "yt", "scale",    # stages
     "rq_c", "rv_c", "dq_c", "dv_c", "b_c", "wv_c",                      # complex solve work
@@ -164,67 +168,117 @@ def _vspace(lay, q, dq, out):
 
 
 @_jit
-def _assemble(mu, Mden, K, D, Gd, nv, m, ip, A):
-    """``A = P [[μM − D − K/μ, Gᵀ], [G, 0]] Pᵀ`` (RCM order ``ip``); ``mu`` real or complex."""
-    N = nv + m
-    for i in range(N):
-        for j in range(N):
-            A[i, j] = 0.0
+def _pack(rw, nv, m):
+    """Sparse rows of ``M``, ``K``, ``D`` (their union pattern) and of ``Φ_q`` from the dense
+    Jacobian, and the band ``(kl, ku)`` of the iteration matrices in RCM order (once per Jacobian).
+
+    The products and the assembly then cost the number of nonzeros, not ``n_v²`` (measured on the
+    stiff chain: the dense products took two thirds of a Newton solve).
+    """
+    Mden, K, D, Gd, ip = rw.Mden, rw.K, rw.D, rw.Gd, rw.ip
+    ptr, col, vm, vk, vd = rw.sp_ptr, rw.sp_col, rw.sp_m, rw.sp_k, rw.sp_d
+    kl = 0
+    ku = 0
+    p = 0
     for i in range(nv):
+        ptr[i] = p
         pi = ip[i]
         for j in range(nv):
-            x = mu * Mden[i, j] - D[i, j] - K[i, j] / mu
-            if x != 0.0:
-                A[pi, ip[j]] = x
+            if Mden[i, j] != 0.0 or K[i, j] != 0.0 or D[i, j] != 0.0:
+                col[p], vm[p], vk[p], vd[p] = j, Mden[i, j], K[i, j], D[i, j]
+                p += 1
+                pj = ip[j]
+                if pi - pj > kl:
+                    kl = pi - pj
+                if pj - pi > ku:
+                    ku = pj - pi
+    ptr[nv] = p
+    gptr, gcol, gval = rw.g_ptr, rw.g_col, rw.g_val
+    p = 0
     for r in range(m):
+        gptr[r] = p
         pr = ip[nv + r]
         for j in range(nv):
-            g = Gd[r, j]
-            if g != 0.0:
-                A[pr, ip[j]] = g
-                A[ip[j], pr] = g
+            if Gd[r, j] != 0.0:
+                gcol[p], gval[p] = j, Gd[r, j]
+                p += 1
+                d = pr - ip[j]
+                if d < 0:
+                    d = -d
+                if d > kl:
+                    kl = d
+                if d > ku:
+                    ku = d
+    gptr[m] = p
+    rw.band[0], rw.band[1] = kl, ku
+
+
+@_inline
+def _abs2(x):
+    """``|x|²`` of a real or complex number (no square root: comparisons only)."""
+    return x.real * x.real + x.imag * x.imag
 
 
 @_jit
-def _band_lu(A, N, piv, band):
-    """LU with partial pivoting of ``A[:N, :N]`` restricted to its band (in place); status.
-
-    ``band = (kl, ku)`` of the matrix (scanned here); fill from row interchanges stays within
-    ``ku + kl`` above the diagonal (Golub & Van Loan 2013, Sec. 4.3.5).
-    """
-    kl = 0
-    ku = 0
-    scale = 0.0
+def _assemble(mu, rw, nv, m, A):
+    """``A = P [[μM − D − K/μ, Gᵀ], [G, 0]] Pᵀ`` (RCM order; ``mu`` real or complex) on the band
+    that the LU fills (columns ``i − kl … i + ku + kl``); returns the largest magnitude."""
+    N = nv + m
+    kl, ku = rw.band[0], rw.band[1]
     for i in range(N):
-        for j in range(N):
-            a = abs(A[i, j])
-            if a != 0.0:
-                if i - j > kl:
-                    kl = i - j
-                if j - i > ku:
-                    ku = j - i
-                if a > scale:
-                    scale = a
-    band[0], band[1] = kl, ku
+        for j in range(max(0, i - kl), min(N, i + ku + kl + 1)):
+            A[i, j] = 0.0
+    ip, ptr, col, vm, vk, vd = rw.ip, rw.sp_ptr, rw.sp_col, rw.sp_m, rw.sp_k, rw.sp_d
+    inv_mu = 1.0 / mu
+    big = 0.0
+    for i in range(nv):
+        pi = ip[i]
+        for p in range(ptr[i], ptr[i + 1]):
+            x = mu * vm[p] - vd[p] - vk[p] * inv_mu
+            A[pi, ip[col[p]]] = x
+            a2 = _abs2(x)
+            if a2 > big:
+                big = a2
+    gptr, gcol, gval = rw.g_ptr, rw.g_col, rw.g_val
+    for r in range(m):
+        pr = ip[nv + r]
+        for p in range(gptr[r], gptr[r + 1]):
+            g = gval[p]
+            pj = ip[gcol[p]]
+            A[pr, pj] = g
+            A[pj, pr] = g
+            if g * g > big:
+                big = g * g
+    return np.sqrt(big)
+
+
+@_jit
+def _band_lu(A, N, kl, ku, scale, piv):
+    """LU with partial pivoting of the band matrix ``A[:N, :N]`` (bandwidths ``kl``, ``ku``) in
+    place; fill from row interchanges stays within ``ku + kl`` above the diagonal (Golub & Van Loan
+    2013, Sec. 4.3.5); status (singular: a pivot below 1e-14 of the largest entry).  The pivot is
+    the entry of largest ``|a|²`` and the multipliers use its reciprocal (complex division and
+    modulus cost a multiple of a multiplication)."""
     uw = ku + kl
+    tiny = (1e-14 * scale) ** 2
     for k in range(N):
         last = min(N - 1, k + kl)
         p = k
-        big = abs(A[k, k])
+        big = _abs2(A[k, k])
         for i in range(k + 1, last + 1):
-            a = abs(A[i, k])
+            a = _abs2(A[i, k])
             if a > big:
                 big, p = a, i
         piv[k] = p
-        if not big > 1e-14 * scale:
+        if not big > tiny:
             return _p.SINGULAR
         jlast = min(N - 1, k + uw)
         if p != k:
             for j in range(k, jlast + 1):
                 A[k, j], A[p, j] = A[p, j], A[k, j]
-        pivot = A[k, k]
+        inv_pivot = 1.0 / A[k, k]
         for i in range(k + 1, last + 1):
-            f = A[i, k] / pivot
+            f = A[i, k] * inv_pivot
             A[i, k] = f
             if f != 0.0:
                 for j in range(k + 1, jlast + 1):
@@ -233,9 +287,9 @@ def _band_lu(A, N, piv, band):
 
 
 @_jit
-def _band_solve(A, N, piv, band, b):
+def _band_solve(A, N, piv, kl, ku, b):
     """Solve with the factors of :func:`_band_lu` in place."""
-    kl, uw = band[0], band[0] + band[1]
+    uw = kl + ku
     for k in range(N):
         p = piv[k]
         if p != k:
@@ -252,22 +306,30 @@ def _band_solve(A, N, piv, band, b):
 
 
 @_jit
-def _newton_solve(lay, q, mu, Mden, K, Gd, nv, m, alpha, beta, A, piv, band, ip, rq, rv, dq, dv, b, wv):
+def _newton_solve(lay, q, mu, rw, nv, m, alpha, beta, A, piv, rq, rv, dq, dv, b, wv):
     r"""``(Δq, Δv)`` of ``(μ I − J)(Δq, Δv) = (r_q, r_v)`` through the saddle-point form (docstring)."""
     nq = lay[4]
+    ip, ptr, col, vm, vk = rw.ip, rw.sp_ptr, rw.sp_col, rw.sp_m, rw.sp_k
     _vspace(lay, q, rq, wv)
+    inv_mu = 1.0 / mu
+    for j in range(nv):
+        wv[j] *= inv_mu
     for i in range(nv):
         acc = 0.0 * mu
-        for j in range(nv):
-            acc += Mden[i, j] * rv[j] + K[i, j] * wv[j] / mu
+        for p in range(ptr[i], ptr[i + 1]):
+            j = col[p]
+            acc += vm[p] * rv[j] + vk[p] * wv[j]
         b[ip[i]] = acc
-    denom = mu + 2.0 * alpha + beta * beta / mu
+    denom = mu + 2.0 * alpha + beta * beta * inv_mu
+    bb = beta * beta
+    gptr, gcol, gval = rw.g_ptr, rw.g_col, rw.g_val
     for r in range(m):
         acc = 0.0 * mu
-        for j in range(nv):
-            acc += Gd[r, j] * (rv[j] - (beta * beta / mu) * wv[j])
+        for p in range(gptr[r], gptr[r + 1]):
+            j = gcol[p]
+            acc += gval[p] * (rv[j] - bb * wv[j])
         b[ip[nv + r]] = acc / denom
-    _band_solve(A, nv + m, piv, band, b)
+    _band_solve(A, nv + m, piv, rw.band[0], rw.band[1], b)
     for i in range(nv):
         dv[i] = b[ip[i]]
     _d.qdot(lay, q, dv, dq)
@@ -283,14 +345,15 @@ def _jacobian(cd, states, ws, rw, t, q, v):
         return st
     act = cd.act
     m = act.shape[0]
+    nv = rw.K.shape[0]
     if m == 0:
+        _pack(rw, nv, 0)
         return _p.OK
     _d.body_states(cd.lay, q, v, ws)
     st = _d.constraints(cd, ws, t, q, v, 0)
     if st != _p.OK:
         return st
     Gd, G, r_blk, blk_v0, blk_w = rw.Gd, ws.G, cd.r_blk, cd.blk_v0, cd.blk_w
-    nv = Gd.shape[1]
     for k in range(m):
         a = act[k]
         for j in range(nv):
@@ -301,6 +364,7 @@ def _jacobian(cd, states, ws, rw, t, q, v):
                 o = blk_v0[blk]
                 for c in range(blk_w[blk]):
                     Gd[k, o + c] += G[a, sl, c]
+    _pack(rw, nv, m)
     return _p.OK
 
 
@@ -309,12 +373,14 @@ def _factor_both(rw, h, nv, m, counters):
     """Real and complex iteration matrices for step ``h``, assembled and factorised; status."""
     mr = MU_REAL / h
     mc = (MU_COMPLEX_RE + 1j * MU_COMPLEX_IM) / h
-    _assemble(mr, rw.Mden, rw.K, rw.D, rw.Gd, nv, m, rw.ip, rw.KK_r)
-    st = _band_lu(rw.KK_r, nv + m, rw.piv_r, rw.band[:2])
+    N = nv + m
+    kl, ku = rw.band[0], rw.band[1]
+    scale = _assemble(mr, rw, nv, m, rw.KK_r)
+    st = _band_lu(rw.KK_r, N, kl, ku, scale, rw.piv_r)
     if st != _p.OK:
         return st
-    _assemble(mc, rw.Mden, rw.K, rw.D, rw.Gd, nv, m, rw.ip, rw.KK_c)
-    st = _band_lu(rw.KK_c, nv + m, rw.piv_c, rw.band[2:])
+    scale = _assemble(mc, rw, nv, m, rw.KK_c)
+    st = _band_lu(rw.KK_c, N, kl, ku, scale, rw.piv_c)
     counters[C_FACT] += 2
     return st
 
@@ -341,16 +407,16 @@ def _rms_scaled(x, scale, rows):
 def _solve_real(lay, q, rw, h, nv, m, alpha, beta, r, out):
     """``out = ((μ_r/h) I − J)⁻¹ r`` (y-space vectors)."""
     nq = lay[4]
+    rq, rv, dq, dv = rw.rq, rw.rv, rw.dq, rw.dv
     for i in range(nq):
-        rw.rq[i] = r[i]
+        rq[i] = r[i]
     for i in range(nv):
-        rw.rv[i] = r[nq + i]
-    _newton_solve(lay, q, MU_REAL / h, rw.Mden, rw.K, rw.Gd, nv, m, alpha, beta, rw.KK_r, rw.piv_r, rw.band[:2],
-                  rw.ip, rw.rq, rw.rv, rw.dq, rw.dv, rw.b, rw.wv)
+        rv[i] = r[nq + i]
+    _newton_solve(lay, q, MU_REAL / h, rw, nv, m, alpha, beta, rw.KK_r, rw.piv_r, rq, rv, dq, dv, rw.b, rw.wv)
     for i in range(nq):
-        out[i] = rw.dq[i]
+        out[i] = dq[i]
     for i in range(nv):
-        out[nq + i] = rw.dv[i]
+        out[nq + i] = dv[i]
 
 
 @_jit
@@ -370,6 +436,11 @@ def _collocation(cd, states, ws, rw, lay, nq, constrained, t, y, h, alpha, beta,
     converged = False
     k = 0
     rq_c, rv_c, dq_c, dv_c = rw.rq_c, rw.rv_c, rw.dq_c, rw.dv_c
+    tmp, err = rw.tmp, rw.err
+    # the complex row of TI: TI[1] + i TI[2]
+    tc0 = TI_[1, 0] + 1j * TI_[2, 0]
+    tc1 = TI_[1, 1] + 1j * TI_[2, 1]
+    tc2 = TI_[1, 2] + 1j * TI_[2, 2]
     for k in range(NEWTON_MAXITER):
         finite = True
         for i in range(3):
@@ -387,18 +458,17 @@ def _collocation(cd, states, ws, rw, lay, nq, constrained, t, y, h, alpha, beta,
         # f_real = Fᵀ TI_real − (μ_r/h) W0 ;  f_complex = Fᵀ TI_complex − (μ_c/h)(W1 + i W2)
         for j in range(n):
             fr = TI_[0, 0] * F[0, j] + TI_[0, 1] * F[1, j] + TI_[0, 2] * F[2, j] - mr * W[0, j]
-            fc = ((TI_[1, 0] + 1j * TI_[2, 0]) * F[0, j] + (TI_[1, 1] + 1j * TI_[2, 1]) * F[1, j]
-                  + (TI_[1, 2] + 1j * TI_[2, 2]) * F[2, j] - mc * (W[1, j] + 1j * W[2, j]))
-            rw.tmp[j] = fr
+            fc = tc0 * F[0, j] + tc1 * F[1, j] + tc2 * F[2, j] - mc * (W[1, j] + 1j * W[2, j])
+            tmp[j] = fr
             if j < nq:
                 rq_c[j] = fc
             else:
                 rv_c[j - nq] = fc
-        _solve_real(lay, q0, rw, h, nv, m, alpha, beta, rw.tmp, rw.err)
-        _newton_solve(lay, q0, mc, rw.Mden, rw.K, rw.Gd, nv, m, alpha, beta, rw.KK_c, rw.piv_c, rw.band[2:],
-                      rw.ip, rq_c, rv_c, dq_c, dv_c, rw.b_c, rw.wv_c)
+        _solve_real(lay, q0, rw, h, nv, m, alpha, beta, tmp, err)
+        _newton_solve(lay, q0, mc, rw, nv, m, alpha, beta, rw.KK_c, rw.piv_c, rq_c, rv_c, dq_c, dv_c, rw.b_c,
+                      rw.wv_c)
         for j in range(n):
-            dW[0, j] = rw.err[j]
+            dW[0, j] = err[j]
             c = dq_c[j] if j < nq else dv_c[j - nq]
             dW[1, j] = c.real
             dW[2, j] = c.imag
@@ -438,7 +508,7 @@ def advance(cd, states, ws, rw, t, y, t_stop, t_bound, h_abs, max_steps, rtol, a
 
     ``info = [t, h_abs, t_old, t_fail, h_abs_old, error_norm_old, have_jac, current_jac,
     have_lu, h_lu]`` carries the controller's memory between calls; the last step's collocation
-    polynomial is left in ``rw.Qpoly`` and its start state in ``rw.y_old`` (dense output).
+    polynomial is left in ``Qpoly`` and its start state in ``y_old`` (dense output).
     Returns an exit code: ``EXIT_REACHED``, ``EXIT_MAX_STEPS`` or a failure.
     """
     lay = cd.lay
@@ -450,6 +520,9 @@ def advance(cd, states, ws, rw, t, y, t_stop, t_bound, h_abs, max_steps, rtol, a
     lam = rw.lam
     f = rw.f
     Z = rw.Z
+    Zt = rw.Zt
+    scale, y_new, y_old, Qpoly = rw.scale, rw.y_new, rw.y_old, rw.Qpoly
+    err, tmp, yt, F0 = rw.err, rw.tmp, rw.yt, rw.F[0]
     steps = 0
     h_abs_old = info[4]
     error_norm_old = info[5]
@@ -513,15 +586,18 @@ def advance(cd, states, ws, rw, t, y, t_stop, t_bound, h_abs, max_steps, rtol, a
                     for p in range(3):
                         x1 = x1 * x
                         for j in range(n):
-                            Z[i, j] += rw.Qpoly[j, p] * x1
+                            Z[i, j] += Qpoly[j, p] * x1
                     for j in range(n):
-                        Z[i, j] += rw.y_old[j] - y[j]
+                        Z[i, j] += y_old[j] - y[j]
             else:
                 for i in range(3):
                     for j in range(n):
                         Z[i, j] = 0.0
             for j in range(n):
-                rw.scale[j] = atol + abs(y[j]) * rtol
+                scale[j] = atol + abs(y[j]) * rtol
+            for i in range(3):  # the guess, for a retry with a fresh Jacobian
+                for j in range(n):
+                    Zt[i, j] = Z[i, j]
             converged = 0
             while True:
                 if not have_lu or h_lu != h:
@@ -548,6 +624,9 @@ def advance(cd, states, ws, rw, t, y, t_stop, t_bound, h_abs, max_steps, rtol, a
                     return st
                 current_jac = True
                 have_lu = False
+                for i in range(3):
+                    for j in range(n):
+                        Z[i, j] = Zt[i, j]
             if converged != 1:
                 h_abs *= 0.5
                 have_lu = False
@@ -555,29 +634,29 @@ def advance(cd, states, ws, rw, t, y, t_stop, t_bound, h_abs, max_steps, rtol, a
                 counters[C_REJ] += 1
                 continue
             for j in range(n):
-                rw.y_new[j] = y[j] + Z[2, j]
+                y_new[j] = y[j] + Z[2, j]
             # error estimate: (μ_r/h − J)⁻¹ (f + Σ e_i Z_i / h)
             for j in range(n):
-                rw.tmp[j] = f[j] + (E_[0] * Z[0, j] + E_[1] * Z[1, j] + E_[2] * Z[2, j]) / h
-            _solve_real(lay, y[:nq], rw, h, nv, m, alpha, beta, rw.tmp, rw.err)
+                tmp[j] = f[j] + (E_[0] * Z[0, j] + E_[1] * Z[1, j] + E_[2] * Z[2, j]) / h
+            _solve_real(lay, y[:nq], rw, h, nv, m, alpha, beta, tmp, err)
             for j in range(n):
-                rw.scale[j] = atol + max(abs(y[j]), abs(rw.y_new[j])) * rtol
+                scale[j] = atol + max(abs(y[j]), abs(y_new[j])) * rtol
             acc = 0.0
             for j in range(n):
-                z = rw.err[j] / rw.scale[j]
+                z = err[j] / scale[j]
                 acc += z * z
             error_norm = np.sqrt(acc / n)
             safety = 0.9 * (2 * NEWTON_MAXITER + 1) / (2 * NEWTON_MAXITER + n_iter)
             if rejected and error_norm > 1.0:
                 for j in range(n):
-                    rw.yt[j] = y[j] + rw.err[j]
-                _rhs(cd, states, ws, lay, nq, constrained, t, rw.yt, alpha, beta, rw.F[0], lam, counters)
+                    yt[j] = y[j] + err[j]
+                _rhs(cd, states, ws, lay, nq, constrained, t, yt, alpha, beta, F0, lam, counters)
                 for j in range(n):
-                    rw.tmp[j] = rw.F[0, j] + (E_[0] * Z[0, j] + E_[1] * Z[1, j] + E_[2] * Z[2, j]) / h
-                _solve_real(lay, y[:nq], rw, h, nv, m, alpha, beta, rw.tmp, rw.err)
+                    tmp[j] = F0[j] + (E_[0] * Z[0, j] + E_[1] * Z[1, j] + E_[2] * Z[2, j]) / h
+                _solve_real(lay, y[:nq], rw, h, nv, m, alpha, beta, tmp, err)
                 acc = 0.0
                 for j in range(n):
-                    z = rw.err[j] / rw.scale[j]
+                    z = err[j] / scale[j]
                     acc += z * z
                 error_norm = np.sqrt(acc / n)
             if not error_norm == error_norm:
@@ -600,17 +679,17 @@ def advance(cd, states, ws, rw, t, y, t_stop, t_bound, h_abs, max_steps, rtol, a
             factor = 1.0
         # dense output polynomial (Q = Zᵀ P) and the start state of the step
         for j in range(n):
-            rw.y_old[j] = y[j]
+            y_old[j] = y[j]
             for p in range(3):
-                rw.Qpoly[j, p] = Z[0, j] * P_[0, p] + Z[1, j] * P_[1, p] + Z[2, j] * P_[2, p]
+                Qpoly[j, p] = Z[0, j] * P_[0, p] + Z[1, j] * P_[1, p] + Z[2, j] * P_[2, p]
         info[2] = t
         for j in range(n):
-            y[j] = rw.y_new[j]
+            y[j] = y_new[j]
         if projection:
             it = _d.project(cd, ws, t_new, y[:nq], y[nq:], proj_tol, max_proj_iter, counters)
             if it < 0:
                 for j in range(n):
-                    y[j] = rw.y_old[j]
+                    y[j] = y_old[j]
                 info[0] = t
                 info[3] = t_new
                 return _p.PROJECTION
@@ -718,7 +797,10 @@ class CompiledRadau(Integrator):
         self._rw = RadauWork(
             Mden=np.ascontiguousarray(Mden), K=np.zeros((nv, nv)), D=np.zeros((nv, nv)), Gd=np.zeros((max(m, 1), nv)),
             KK_r=np.zeros((N, N)), KK_c=np.zeros((N, N), complex), piv_r=np.zeros(N, np.int64),
-            piv_c=np.zeros(N, np.int64), band=np.zeros(4, np.int64), ip=self._ordering(system, Mden, N),
+            piv_c=np.zeros(N, np.int64), band=np.zeros(2, np.int64), ip=self._cached_ordering(system, Mden, N),
+            sp_ptr=np.zeros(nv + 1, np.int64), sp_col=np.zeros(nv * nv, np.int64), sp_m=np.zeros(nv * nv),
+            sp_k=np.zeros(nv * nv), sp_d=np.zeros(nv * nv), g_ptr=np.zeros(m + 1, np.int64),
+            g_col=np.zeros(max(m, 1) * nv, np.int64), g_val=np.zeros(max(m, 1) * nv),
             f=np.zeros(n), y_new=np.zeros(n), y_old=np.zeros(n), Z=np.zeros((3, n)), W=np.zeros((3, n)),
             F=np.zeros((3, n)), dW=np.zeros((3, n)), Zt=np.zeros((3, n)), yt=np.zeros(n), scale=np.zeros(n),
             rq_c=np.zeros(nq, complex), rv_c=np.zeros(nv, complex), dq_c=np.zeros(nq, complex),
@@ -746,12 +828,20 @@ class CompiledRadau(Integrator):
         self._sync()
 
     # --- set-up ---------------------------------------------------------------------------------
+    def _cached_ordering(self, system, Mden, N):
+        """:meth:`_ordering`, computed once per compiled model (model set-up, like the packing)."""
+        cache = self._cm.setup_cache
+        if "radau_ordering" not in cache:
+            cache["radau_ordering"] = self._ordering(system, Mden, N)
+        return cache["radau_ordering"]
+
     def _ordering(self, system, Mden, N):
         """Reverse Cuthill–McKee positions of the (n_v + m) unknowns of the iteration matrices.
 
         Pattern: the mass matrix, ``Φ_q`` and the force Jacobians at the initial state and at a
         randomly perturbed one (so that couplings through elements that are unloaded at ``t0``,
-        e.g. an open contact, still shape the order; the LU takes the actual band each time).
+        e.g. an open contact, still shape the order; the band is taken from the actual pattern at
+        every Jacobian, :func:`_pack`).
         """
         nv = system.n_v
         cm, cd = self._cm, self._cd

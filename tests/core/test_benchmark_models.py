@@ -12,14 +12,14 @@ import warnings
 import numpy as np
 import pytest
 
-from core.benchmark_problems import AndrewsSqueezer
+from core.benchmarks.references import iftomm_a02_reference
+from core.benchmarks.testset import AndrewsSqueezer
 from core.dynamics import accelerations
 from core.integrators import simulate
 from core.models import (
     andrews_angles_from_cartesian,
     andrews_cartesian,
     iftomm_a02_four_bar_chain,
-    iftomm_a02_reference,
     iftomm_a04_bricard,
 )
 

@@ -25,6 +25,7 @@ import numpy as np
 import pytest
 
 from core import drivers, frames, models
+from core.benchmarks.references import n_link_chain_reference
 from core.compiled import (
     CompiledForces,
     NotCompilable,
@@ -277,7 +278,7 @@ def test_chain_tip_error_against_minimal_coordinate_reference(method):
     """8-link chain at t = 1 s: tip error below 1e-6 m at tol 1e-8 and shrinking with the tolerance."""
     n = 8
     model = models.n_link_chain(n, planar=True)
-    ref, _ = models.n_link_chain_reference(n)
+    ref, _ = n_link_chain_reference(n)
     errs = []
     for tol in (1e-5, 1e-8):
         res = simulate(model, (0.0, 1.0), method, t_eval=[1.0], rtol=tol, atol=tol, compute_multipliers=False)
@@ -348,7 +349,7 @@ def test_body_with_a_singular_mass_block_point_mass_pendulum(method):
     """A point mass (no rotational inertia) has a singular mass block: its coordinates join the
     border of the compiled saddle solve.  The pendulum's angle follows the exact Jacobi-elliptic
     solution (IFToMM A01 geometry, released horizontally) to the tolerance."""
-    from core.workprecision import pendulum_angle_exact
+    from core.benchmarks.references import pendulum_angle_exact
 
     model = models.simple_pendulum()
     cm = compile_model(model)
@@ -665,7 +666,7 @@ def test_radau_chain_against_minimal_coordinate_reference(method):
     """8-link chain at t = 1 s: the error of the order-5 method falls with the tolerance and
     reaches below 1e-8 m at rtol 1e-8 (the index-1 formulation with the saddle-point Newton solve)."""
     model = models.n_link_chain(8, planar=True)
-    ref, _ = models.n_link_chain_reference(8)
+    ref, _ = n_link_chain_reference(8)
     errs = []
     for tol in (1e-5, 1e-8):
         res = simulate(model, (0.0, 1.0), method, t_eval=[1.0], rtol=tol, atol=tol, compute_multipliers=False)
@@ -678,9 +679,11 @@ def test_radau_chain_against_minimal_coordinate_reference(method):
 def test_radau_stiff_chain_no_stability_limit(k):
     """Penalty chain N = 2 (k = 1e6, 1e8 N/m, undamped): Radau IIA is L-stable, so its step follows the
     accuracy asked for, never a stability bound (no stiffness warning); its error against the
-    resolved DOP853 reference falls with the tolerance.  Reference: core.workprecision's independent
+    resolved DOP853 reference falls with the tolerance.  Reference: core.benchmarks.references' independent
     penalty right-hand side at rtol 1e-12."""
-    from core.workprecision import _stiff_chain_tip_reference
+    from core.benchmarks.references import (
+        stiff_chain_tip_reference as _stiff_chain_tip_reference,
+    )
 
     model = models.n_link_chain(2, planar=True, stiff_k=k)
     t_end = 0.2
@@ -729,3 +732,18 @@ def test_radau_fails_honestly_on_a_singular_iteration_matrix():
     b.add_body("p", 1.0, 0.0, (0.0, 0.0))
     res = simulate(b.build(), (0.0, 0.1), "jit-radau", n_output=3)
     assert res.status == "failed" and ("singular" in res.message or "not positive" in res.message)
+
+
+def test_radau_spatial_chain_against_dop853():
+    """Spatial bodies (Euler parameters, 6-wide velocity blocks, the ``δθ̄ = 2 L(p) δp`` map of the
+    Newton solve) through the Radau loop: the 4-link spatial chain at rtol 1e-8 agrees with a tight
+    DOP853 run of the numpy model to 1e-6 in every coordinate, and the Euler parameters stay unit."""
+    model = models.n_link_chain(4, spatial=True)
+    t = np.linspace(0.0, 0.5, 6)
+    ref = simulate(model, (0.0, 0.5), "dop853-projection", t_eval=t, rtol=1e-11, atol=1e-11)
+    for method in ("jit-radau-projection", "jit-radau-baumgarte"):
+        res = simulate(model, (0.0, 0.5), method, t_eval=t, rtol=1e-8, atol=1e-8)
+        assert res.status == "finished", res.message
+        _close(res.q, ref.q, f"{method} spatial chain", 1e-6)
+        p = res.q[:, :28].reshape(len(t), 4, 7)[:, :, 3:]
+        assert np.max(np.abs(np.linalg.norm(p, axis=2) - 1.0)) < 1e-10

@@ -283,7 +283,7 @@ def test_radau_ggl_andrews_configuration_dependent_mass():
     With M frozen at the step start the method is first order in M's variation (error ~5e-3
     at rtol 1e-6); done right the global error follows the tolerance.
     """
-    from core.benchmark_problems import AndrewsSqueezer
+    from core.benchmarks.testset import AndrewsSqueezer
 
     P = AndrewsSqueezer()
     ref = P.reference
@@ -302,7 +302,7 @@ def test_radau_ggl_andrews_tight_tolerance():
     The published reference (PSIDE, 1e-14) agrees with an index-1 DOP853 solution at
     rtol = 3e-14 to 8e-11 relative; 1e-8 leaves room for that and the method's own error.
     """
-    from core.benchmark_problems import AndrewsSqueezer
+    from core.benchmarks.testset import AndrewsSqueezer
 
     P = AndrewsSqueezer()
     ref = P.reference
@@ -317,7 +317,7 @@ def test_radau_ggl_andrews_tight_tolerance():
 @pytest.mark.parametrize("rtol", [1e-6, pytest.param(1e-9, marks=pytest.mark.slow)])
 def test_radau_ggl_car_axis_reference(rtol):
     """Index-3 car axis with the moving road point (ν = ν(t, q)), published reference at t = 3."""
-    from core.benchmark_problems import CarAxis
+    from core.benchmarks.testset import CarAxis
 
     P = CarAxis()
     ref = P.reference

@@ -1,4 +1,4 @@
-"""Canonical models (core.models) and published DAE test problems (core.benchmark_problems).
+"""Canonical models (core.models) and published DAE test problems (core.benchmarks.testset).
 
 Oracles: published reference solutions of the Bari test set (Andrews at t = 0.03 s, car axis at
 t = 3), the minimal-coordinate chain ODE integrated by DOP853 at 1e-13, closed-form motions
@@ -17,7 +17,8 @@ from scipy.integrate import solve_ivp
 
 import core.integrators as CI
 from core import models as M
-from core.benchmark_problems import AndrewsSqueezer, CarAxis
+from core.benchmarks.references import n_link_chain_reference
+from core.benchmarks.testset import AndrewsSqueezer, CarAxis
 from core.dynamics import accelerations
 from core.system import as_dense
 
@@ -157,7 +158,7 @@ def test_chain_definition():
 
 def test_chain_reference_matches_single_rod_energy():
     # N = 1 is a compound pendulum; the reference must conserve its energy to ~rtol
-    tip, hist = M.n_link_chain_reference(1, t_end=1.0)
+    tip, hist = n_link_chain_reference(1, t_end=1.0)
     th, om = hist["theta_1 [rad]"].to_numpy(), hist["omega_1 [rad/s]"].to_numpy()
     E = 0.5 * (1.0 / 3.0) * om**2 + 9.81 * 0.5 * np.sin(th)
     assert np.abs(E - E[0]).max() < 1e-10
@@ -181,7 +182,7 @@ def test_chain_planar_and_spatial_agree():
 def test_chain_matches_minimal_coordinate_reference():
     method = _method("dop853-projection", "dop853", "rk45-projection")
     rtol = 1e-8
-    tip_ref, _ = M.n_link_chain_reference(2, t_end=1.0)
+    tip_ref, _ = n_link_chain_reference(2, t_end=1.0)
     m = M.n_link_chain(2)
     r = CI.simulate(m, (0.0, 1.0), method, rtol=rtol, atol=rtol, n_output=2)
     assert r.status == "finished"
@@ -327,7 +328,7 @@ def test_benchmark_problems_independent_of_core_integrators():
 def test_stiff_chain_converges_to_rigid_chain_like_one_over_k():
     """Penalty joints: the constraint violation, hence the motion error, is O(1/k) (λ ≈ −k Φ)."""
     method = _method("dop853", "dop853-projection", "rk45")
-    tip_ref, _ = M.n_link_chain_reference(2, t_end=0.3)
+    tip_ref, _ = n_link_chain_reference(2, t_end=0.3)
     errs = []
     for k in (1e4, 1e5):
         m = M.n_link_chain(2, stiff_k=k)

@@ -23,7 +23,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from core import frames
-from core.benchmark_problems import AndrewsSqueezer
+from core.benchmarks.references import iftomm_a02_reference, n_link_chain_reference
+from core.benchmarks.testset import AndrewsSqueezer
 from core.dynamics import accelerations
 from core.integrators import get_method, simulate
 from core.model import ModelBuilder
@@ -35,10 +36,8 @@ from core.models import (
     double_pendulum,
     four_bar,
     iftomm_a02_four_bar_chain,
-    iftomm_a02_reference,
     iftomm_a04_bricard,
     n_link_chain,
-    n_link_chain_reference,
     simple_pendulum,
     slider_crank,
 )

@@ -1,4 +1,4 @@
-"""Tests of the work-precision harness (core.workprecision).
+"""Tests of the work-precision harness (core.benchmarks).
 
 Fast: tiny grids on the N = 2 chain; the pendulum reference is checked against an independent
 DOP853 integration of the pendulum ODE.  Timing columns are never asserted.
@@ -15,9 +15,12 @@ import pandas as pd
 import pytest
 from scipy.integrate import solve_ivp
 
-from core import workprecision as wp
+from core import benchmarks as wp
+from core.benchmarks import references as refs
+from core.benchmarks.references import n_link_chain_reference
+from core.errors import NameTakenError, UnknownNameError
 from core.integrators import simulate
-from core.models import chain_tip, n_link_chain, n_link_chain_reference
+from core.models import chain_tip, n_link_chain
 
 CHAIN = "chain2-planar"
 
@@ -129,11 +132,11 @@ def test_registry_grids_and_unknown_names():
         assert set(wp.GRID_NAMES) <= set(p.grids), name
     for s in ("quick", "standard"):
         assert set(wp.PROBLEM_SETS[s]) <= set(wp.PROBLEMS)
-    with pytest.raises(ValueError, match="unknown work-precision problem"):
+    with pytest.raises(UnknownNameError, match="unknown work-precision problem 'no-such-problem'; registered: chain2"):
         wp.run_work_precision("no-such-problem")
     with pytest.raises(ValueError, match="unknown integrator"):
         wp.run_work_precision(CHAIN, methods=["no-such-method"])
-    with pytest.raises(ValueError, match="already registered"):
+    with pytest.raises(NameTakenError, match="work-precision problem name 'chain2-planar' is taken"):
         wp.register_problem(dataclasses.replace(wp.PROBLEMS[CHAIN]))
     assert [s.name for s in wp.work_precision_scenes()] == ["work-precision"]
 
@@ -197,10 +200,10 @@ def test_methods_that_cannot_integrate_a_system_are_left_out_of_its_table():
 def test_a04_reference_agrees_with_the_numpy_path_and_conserves_energy():
     """The A04 reference (compiled DOP853 + projection, 1e-12) against scipy DOP853 + projection on the
     numpy right-hand side at 1e-11: two implementations of the equations agree to 1e-8 m at t = 10 s."""
-    ref = wp._a04_reference()
-    system = wp._a04_system()
-    res = simulate(system, (0.0, wp.A04_T_END), "dop853-projection", n_output=11, rtol=1e-11, atol=1e-11,
+    ref = refs.iftomm_a04_reference()
+    system = refs.iftomm_a04_system()
+    res = simulate(system, (0.0, refs.A04_T_END), "dop853-projection", n_output=11, rtol=1e-11, atol=1e-11,
                    compute_multipliers=False)
     assert res.status == "finished"
-    assert np.linalg.norm(wp._a04_tip(system, res.q[-1]) - ref) < 1e-8
+    assert np.linalg.norm(refs.iftomm_a04_p2(system, res.q[-1]) - ref) < 1e-8
     assert np.max(np.abs(res.energy - res.energy[0])) < 1e-8 * 5 * 9.81

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from .system import ConstrainedSystem
+from ..system import ConstrainedSystem
 
 Array = NDArray[np.float64]
 

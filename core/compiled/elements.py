@@ -48,6 +48,7 @@ from .protocol import (
     L_DIM,
     L_NB,
     MAX_SLOTS,
+    NONFINITE,
     OK,
     WANT_GAMMA,
     WANT_NU,
@@ -736,6 +737,168 @@ def compile_spring_dampers(kind, layout) -> CompiledForces:
     fd = np.hstack([pad3(kind.si), pad3(kind.sj), kind.k[:, None], kind.c[:, None], kind.L0[:, None], has, progs])
     return CompiledForces(forces=spring_dampers, fd=np.ascontiguousarray(fd), ix=_ints(kind.bi, kind.bj),
                           names=list(kind.names), jacobian=spring_dampers_jacobian, what="spring-damper")
+
+
+# --- springs on element coordinates (rotational spring-damper, bushing) -------------------------
+#
+# The kernels below evaluate the element coordinates of :mod:`core.forces.coordinates` — dot-1
+# ``x = (A_i ū)ᵀ(A_j w̄)``, dot-2 ``x = (A_i ū)ᵀ(r_Q − r_P)``, their atan2 and linear combinations —
+# with the gradient row ``G = ∂x/∂(v_i, v_j)`` in 3-D block form (translation t, body-frame
+# rotation c, per body), ``ẋ = G (v_i, v_j)`` and ``Q = −f G`` (virtual work ``δW = −f δx``).
+# Their Jacobians on the compiled path are the forward differences of
+# :func:`core.compiled.dynamics.force_jacobian` (the numpy kinds have exact ones).
+
+
+@_inline
+def _dot1_coordinate(A, bi, u0, u1, u2, bj, w0, w1, w2):
+    """``x = (A_i ū)ᵀ(A_j w̄)`` and its rotational gradient blocks ``c_i, c_j`` (no translation part)."""
+    a0, a1, a2 = V.Av(A, bi, u0, u1, u2)
+    b0, b1, b2 = V.Av(A, bj, w0, w1, w2)
+    ci0, ci1, ci2 = V.uC(A, bi, u0, u1, u2, b0, b1, b2)
+    cj0, cj1, cj2 = V.uC(A, bj, w0, w1, w2, a0, a1, a2)
+    return a0 * b0 + a1 * b1 + a2 * b2, ci0, ci1, ci2, cj0, cj1, cj2
+
+
+@_inline
+def _rotation_rate(w, bi, bj, ci0, ci1, ci2, cj0, cj1, cj2):
+    """``ẋ = c_i·ω̄_i + c_j·ω̄_j`` of a coordinate with rotational gradient blocks only."""
+    return (ci0 * w[bi, 0] + ci1 * w[bi, 1] + ci2 * w[bi, 2]
+            + cj0 * w[bj, 0] + cj1 * w[bj, 1] + cj2 * w[bj, 2])
+
+
+@_inline
+def _wrap(x):
+    return np.arctan2(np.sin(x), np.cos(x))
+
+
+@force_kernel
+def rotational_spring_dampers(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
+    r"""``θ = atan2(g_iᵀ f_j, f_iᵀ f_j)``, ``T = k wrap(θ − θ₀) + c θ̇ + T_a(t)``, ``Q = −T ∂θ/∂q``
+    (:class:`core.forces.springs.RotationalSpringDamper`; fd: f̄_i, ḡ_i, f̄_j, k, c, θ₀, has actuator,
+    program)."""
+    nb, dim = lay[L_NB], lay[L_DIM]
+    for e in range(ix.shape[0]):
+        bi, bj = ix[e, 0], ix[e, 1]
+        a, ai0, ai1, ai2, aj0, aj1, aj2 = _dot1_coordinate(A, bi, fd[e, 3], fd[e, 4], fd[e, 5],
+                                                           bj, fd[e, 6], fd[e, 7], fd[e, 8])
+        b, bi0, bi1, bi2, bj0, bj1, bj2 = _dot1_coordinate(A, bi, fd[e, 0], fd[e, 1], fd[e, 2],
+                                                           bj, fd[e, 6], fd[e, 7], fd[e, 8])
+        rho2 = a * a + b * b
+        if not rho2 > 0.0:
+            err[1] = e
+            return NONFINITE
+        gi0, gi1, gi2 = (b * ai0 - a * bi0) / rho2, (b * ai1 - a * bi1) / rho2, (b * ai2 - a * bi2) / rho2
+        gj0, gj1, gj2 = (b * aj0 - a * bj0) / rho2, (b * aj1 - a * bj1) / rho2, (b * aj2 - a * bj2) / rho2
+        thd = _rotation_rate(w, bi, bj, gi0, gi1, gi2, gj0, gj1, gj2)
+        ta = 0.0
+        if fd[e, 12] != 0.0:
+            st, ta, x1, x2 = tf_evaluate(fd[e, 13:], t)
+            if st != OK:
+                err[1] = e
+                return st
+        T = fd[e, 9] * _wrap(np.arctan2(a, b) - fd[e, 11]) + fd[e, 10] * thd + ta
+        V.add_block(Q, bi, nb, dim, 0.0, 0.0, 0.0, gi0, gi1, gi2, -T)
+        V.add_block(Q, bj, nb, dim, 0.0, 0.0, 0.0, gj0, gj1, gj2, -T)
+    return OK
+
+
+def compile_rotational_spring_dampers(kind, layout) -> CompiledForces:
+    from ..drivers import constant
+
+    progs = encode_rows([constant(0.0) if a is None else a for a in kind.act],
+                        [f"actuator of rotational spring-damper {n!r}" for n in kind.names])
+    has = np.array([0.0 if a is None else 1.0 for a in kind.act])[:, None]
+    fd = np.hstack([pad3(kind.fi), pad3(kind.gi), pad3(kind.fj), kind.k[:, None], kind.c[:, None],
+                    kind.theta0[:, None], has, progs])
+    return CompiledForces(forces=rotational_spring_dampers, fd=np.ascontiguousarray(fd), ix=_ints(kind.bi, kind.bj),
+                          names=list(kind.names), what="rotational spring-damper")
+
+
+@_inline
+def _bushing_rotation(A, fd, e, bi, bj, a, b):
+    """``R_ab = (A_i m̄_i,a)ᵀ(A_j m̄_j,b)`` (marker axes a of i and b of j) with its gradient blocks."""
+    return _dot1_coordinate(A, bi, fd[e, 6 + a], fd[e, 9 + a], fd[e, 12 + a],
+                            bj, fd[e, 15 + b], fd[e, 18 + b], fd[e, 21 + b])
+
+
+@force_kernel
+def bushings(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
+    r"""Linear bushing (:class:`core.forces.springs.Bushing`): deflections ``Δ_t = M_iᵀ(r_Q − r_P)``
+    (dot-2 per marker axis), ``Δ_r = ½ vee(R − Rᵀ)`` (spatial) or ``atan2(R₁₀, R₀₀)`` (planar) of
+    ``R = M_iᵀM_j``, minus their values at build; ``f = K Δ + C Δ̇`` per component, ``Q = −Σ f G``.
+    fd: s̄_i, s̄_j, M̄_i (row-major 3×3, columns = marker axes), M̄_j, K (6), C (6), Δ₀ (6);
+    planar components are (x, y, rotation) in the first three entries of K, C, Δ₀."""
+    nb, dim = lay[L_NB], lay[L_DIM]
+    for e in range(ix.shape[0]):
+        bi, bj = ix[e, 0], ix[e, 1]
+        p0, p1, p2 = fd[e, 0], fd[e, 1], fd[e, 2]
+        s0, s1, s2 = fd[e, 3], fd[e, 4], fd[e, 5]
+        d0, d1, d2 = V.rel_point(r, A, bi, p0, p1, p2, bj, s0, s1, s2)
+        for k in range(dim):  # translations: dot-2 along marker axis k of body i
+            u0, u1, u2 = fd[e, 6 + k], fd[e, 9 + k], fd[e, 12 + k]
+            a0, a1, a2 = V.Av(A, bi, u0, u1, u2)
+            x = a0 * d0 + a1 * d1 + a2 * d2
+            x0_, x1_, x2_ = V.uC(A, bi, u0, u1, u2, d0, d1, d2)
+            y0, y1, y2 = V.uC(A, bi, p0, p1, p2, a0, a1, a2)
+            ci0, ci1, ci2 = x0_ - y0, x1_ - y1, x2_ - y2
+            cj0, cj1, cj2 = V.uC(A, bj, s0, s1, s2, a0, a1, a2)
+            xd = (-a0 * rd[bi, 0] - a1 * rd[bi, 1] - a2 * rd[bi, 2] + a0 * rd[bj, 0] + a1 * rd[bj, 1]
+                  + a2 * rd[bj, 2] + _rotation_rate(w, bi, bj, ci0, ci1, ci2, cj0, cj1, cj2))
+            f = fd[e, 24 + k] * (x - fd[e, 36 + k]) + fd[e, 30 + k] * xd
+            V.add_block(Q, bi, nb, dim, -a0, -a1, -a2, ci0, ci1, ci2, -f)
+            V.add_block(Q, bj, nb, dim, a0, a1, a2, cj0, cj1, cj2, -f)
+        if dim == 2:
+            ra, ai0, ai1, ai2, aj0, aj1, aj2 = _bushing_rotation(A, fd, e, bi, bj, 1, 0)
+            rb, bi0, bi1, bi2, bj0, bj1, bj2 = _bushing_rotation(A, fd, e, bi, bj, 0, 0)
+            rho2 = ra * ra + rb * rb
+            if not rho2 > 0.0:
+                err[1] = e
+                return NONFINITE
+            ci2 = (rb * ai2 - ra * bi2) / rho2
+            cj2 = (rb * aj2 - ra * bj2) / rho2
+            xd = ci2 * w[bi, 2] + cj2 * w[bj, 2]
+            f = fd[e, 26] * _wrap(np.arctan2(ra, rb) - fd[e, 38]) + fd[e, 32] * xd
+            V.add_block(Q, bi, nb, dim, 0.0, 0.0, 0.0, 0.0, 0.0, ci2, -f)
+            V.add_block(Q, bj, nb, dim, 0.0, 0.0, 0.0, 0.0, 0.0, cj2, -f)
+        else:
+            for k in range(3):  # Δ_r,k = ½ (R[k2, k1] − R[k1, k2]) with (k1, k2) cyclic after k
+                k1 = (k + 1) % 3
+                k2 = (k + 2) % 3
+                x1, pi0, pi1, pi2, pj0, pj1, pj2 = _bushing_rotation(A, fd, e, bi, bj, k2, k1)
+                x2, qi0, qi1, qi2, qj0, qj1, qj2 = _bushing_rotation(A, fd, e, bi, bj, k1, k2)
+                x = 0.5 * (x1 - x2)
+                ci0, ci1, ci2 = 0.5 * (pi0 - qi0), 0.5 * (pi1 - qi1), 0.5 * (pi2 - qi2)
+                cj0, cj1, cj2 = 0.5 * (pj0 - qj0), 0.5 * (pj1 - qj1), 0.5 * (pj2 - qj2)
+                xd = _rotation_rate(w, bi, bj, ci0, ci1, ci2, cj0, cj1, cj2)
+                f = fd[e, 27 + k] * (x - fd[e, 39 + k]) + fd[e, 33 + k] * xd
+                V.add_block(Q, bi, nb, dim, 0.0, 0.0, 0.0, ci0, ci1, ci2, -f)
+                V.add_block(Q, bj, nb, dim, 0.0, 0.0, 0.0, cj0, cj1, cj2, -f)
+    return OK
+
+
+def _pad_axes(M) -> np.ndarray:
+    """Body-fixed marker axes (n, d, d; columns = axes) as row-major 3×3 blocks, flattened (n, 9)."""
+    M = np.asarray(M, float)
+    out = np.zeros((M.shape[0], 3, 3))
+    d = M.shape[1]
+    out[:, :d, :d] = M
+    if d == 2:
+        out[:, 2, 2] = 1.0
+    return out.reshape(M.shape[0], 9)
+
+
+def _pad6(a) -> np.ndarray:
+    a = np.atleast_2d(np.asarray(a, float))
+    out = np.zeros((a.shape[0], 6))
+    out[:, : a.shape[1]] = a
+    return out
+
+
+def compile_bushings(kind, layout) -> CompiledForces:
+    fd = np.hstack([pad3(kind.si), pad3(kind.sj), _pad_axes(kind.Mi), _pad_axes(kind.Mj), _pad6(kind.K),
+                    _pad6(kind.C), _pad6(kind.x0)])
+    return CompiledForces(forces=bushings, fd=np.ascontiguousarray(fd), ix=_ints(kind.bi, kind.bj),
+                          names=list(kind.names), what="bushing")
 
 
 # --- plane contact ------------------------------------------------------------------------------

@@ -20,6 +20,8 @@ t, c)``                       layout: planar ``(t₀, t₁, c₂)``, spatial ``(
 nb, dim, s̄, F, sign)``
 ``add_body_moment(Q, b, nb,   ``Q_b`` rotational part ``+= M̄`` (body-frame moment; planar: z)
 dim, M̄)``
+``add_block(Q, b, nb, dim,    ``Q_b += s · (t; c)``: a generalized force given in the 3-D block
+t, c, s)``                    form (translation, body-frame rotation) of a gradient row
 ============================  ================================================================
 
 Planar bodies rotate about z, so ``C(s̄) ω = A(ω × s̄)`` and ``a^q = A(ω × (ω × s̄))`` reproduce
@@ -37,7 +39,7 @@ import numba
 _inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
 
 __all__ = ["Av", "ATv", "cross", "vel", "aq", "uC", "rel_point", "rel_vel", "put_row", "add_point_force",
-           "add_body_moment", "velocity_offset"]
+           "add_body_moment", "add_block", "velocity_offset"]
 
 
 @_inline
@@ -150,6 +152,26 @@ def add_body_moment(Q, b, nb, dim, m0, m1, m2, sign):
         Q[o + 3] += sign * m0
         Q[o + 4] += sign * m1
         Q[o + 5] += sign * m2
+
+
+@_inline
+def add_block(Q, b, nb, dim, t0, t1, t2, c0, c1, c2, s):
+    """``Q_b += s · (t; c)`` in the model's velocity layout (planar: ``(t₀, t₁, c₂)``; skips the ground)."""
+    if b >= nb:
+        return
+    if dim == 2:
+        o = 3 * b
+        Q[o] += s * t0
+        Q[o + 1] += s * t1
+        Q[o + 2] += s * c2
+    else:
+        o = 6 * b
+        Q[o] += s * t0
+        Q[o + 1] += s * t1
+        Q[o + 2] += s * t2
+        Q[o + 3] += s * c0
+        Q[o + 4] += s * c1
+        Q[o + 5] += s * c2
 
 
 @_inline

@@ -432,6 +432,13 @@ class RotationalSpringDamperKind(ForceKind):
         dth, thd, T, _ = self._torque(bs, t, c)
         return {"angle [rad]": c.x[:, 0], "torque [N m]": T}
 
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_rotational_spring_dampers`; Jacobian
+        by differences on the compiled path)."""
+        from ..compiled.elements import compile_rotational_spring_dampers
+
+        return compile_rotational_spring_dampers(self, layout)
+
 
 # --------------------------------------------------------------------------------------------
 # bushing
@@ -576,3 +583,10 @@ class BushingKind(ForceKind):
             out[f"a{r} [rad]"] = delta[:, d + k]
             out[f"M{r} [N m]"] = -f[:, d + k]
         return out
+
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_bushings`; Jacobian by differences on
+        the compiled path)."""
+        from ..compiled.elements import compile_bushings
+
+        return compile_bushings(self, layout)

@@ -96,6 +96,15 @@ def _model(dim, joint, seed, ground=False, springs=True, loads=False):
         b.add_point_spring("ps", "ground", "a", rng.uniform(-1, 1, dim), stiffness=150.0, damping=2.0)
         b.add_spring_damper("sd", "a", "b", rng.uniform(-1, 1, dim), rng.uniform(-1, 1, dim), 80.0, 1.5,
                             free_length=0.4, actuator=drivers.polynomial([0.5, -1.0, 0.3]))
+        b.add_rotational_spring_damper("rsd", "a", "b", 40.0, 0.8, free_angle=0.2,
+                                       actuator=drivers.harmonic(0.5, 3.0), axis=None if dim == 2 else axis)
+        ang = rng.uniform(-np.pi, np.pi)
+        axes = (np.array([[np.cos(ang), -np.sin(ang)], [np.sin(ang), np.cos(ang)]]) if dim == 2 else
+                frames.euler_to_matrix(frames.axis_angle_to_euler(_unit(rng), ang)))
+        b.add_bushing("bush", bi, "b", rng.uniform(-1, 1, dim), rng.uniform(50.0, 200.0, dim),
+                      rng.uniform(5.0, 20.0, 1 if dim == 2 else 3), rng.uniform(0.5, 2.0, dim),
+                      rng.uniform(0.1, 0.5, 1 if dim == 2 else 3), axes=axes,
+                      point_j=rng.uniform(-1, 1, dim))
     if loads:
         b.add_applied_force("F", "a", rng.uniform(-1, 1, dim), [drivers.harmonic(2.0, 3.0), 1.5] + [0.5] * (dim - 2),
                             frame="body")
@@ -747,3 +756,31 @@ def test_radau_spatial_chain_against_dop853():
         _close(res.q, ref.q, f"{method} spatial chain", 1e-6)
         p = res.q[:, :28].reshape(len(t), 4, 7)[:, :, 3:]
         assert np.max(np.abs(np.linalg.norm(p, axis=2) - 1.0)) < 1e-10
+
+
+@pytest.mark.parametrize("method", ["jit-dop853-projection", "jit-radau-projection"])
+def test_compiled_torsional_oscillator_and_bushing(method):
+    """Rotational spring-damper and bushing kernels in motion (the implicit method with their
+    difference Jacobians).  A rod pinned at its end to the ground with a torsion spring k, no
+    gravity, released at θ = 0 with the free angle θ₀ = −0.3 rad: θ(t) = θ₀ (1 − cos ω t),
+    ω² = k / (m l²/3).  A mass hanging on a damped bushing with rotated marker axes (isotropic
+    translational stiffness k) settles under gravity to the static deflection m g / k, straight down."""
+    m, L, k = 2.0, 0.8, 30.0
+    b = ModelBuilder(2, "torsion", gravity=(0.0, 0.0))
+    b.add_body("rod", m, m * L**2 / 12, (L / 2, 0.0))
+    b.add_revolute("pin", "ground", "rod", (0.0, 0.0))
+    b.add_rotational_spring_damper("torsion", "ground", "rod", k, free_angle=-0.3)
+    model = b.build()
+    t = np.linspace(0.0, 1.0, 6)
+    res = simulate(model, (0.0, 1.0), method, t_eval=t, rtol=1e-10, atol=1e-10)
+    assert res.status == "finished", res.message
+    omega = np.sqrt(k / (m * L**2 / 3))
+    assert np.max(np.abs(res.q[:, 2] + 0.3 * (1.0 - np.cos(omega * t)))) < 1e-7
+    b = ModelBuilder(3, "bushing-mount")
+    b.add_body("mass", 5.0, [0.1, 0.2, 0.3], (0.0, 0.0, 0.0))
+    axes = frames.euler_to_matrix(frames.axis_angle_to_euler(np.array([1.0, 2.0, 2.0]) / 3.0, 0.7))
+    b.add_bushing("mount", "ground", "mass", (0.0, 0.0, 0.0), 2e4, 500.0, 400.0, 5.0, axes=axes)
+    model = b.build()
+    res = simulate(model, (0.0, 3.0), method.replace("-projection", ""), t_eval=[3.0], rtol=1e-8, atol=1e-10)
+    assert res.status == "finished", res.message
+    assert abs(res.q[-1, 2] + 5.0 * 9.81 / 2e4) < 1e-6 and np.max(np.abs(res.q[-1, :2])) < 1e-6

@@ -50,6 +50,12 @@ keeps the step when the predicted change is below 20 %).  When the iteration fai
 Jacobian, it restarts from the same starting guess with a fresh one; when it fails with a fresh
 one, the step is halved (RADAU5).
 
+Besides the common counters, a run reports ``n_newton_failures``: the attempts whose Newton
+iteration failed even with a fresh Jacobian, each followed by halving the step (the rest of
+``n_rejected`` are error-test rejections).  On the 8-link penalty chain (k = 1e6) about 60 % of the
+rejections are Newton failures, as for scipy's Radau on the same equations: the stiff springs
+rotate with the links within a step, so the Jacobian of the step start goes stale.
+
 Error control is RADAU5's (estimate ``(γ₀/h − J)⁻¹ (f(y₀) + Σ eᵢ Zᵢ / h)``, norm
 ``‖e / (atol + rtol |y|)‖_RMS``); there is no stability limit and so no stiffness warning.
 Failures are honest: a step below 10 ulp(t) (Newton not converging at any step, non-finite
@@ -99,7 +105,7 @@ _jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
 _inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
 
 # counters beyond compiled_rk's layout (steps, rejected, rhs, factorisations, ...)
-C_JAC, C_NEWTON = 7, 8
+C_JAC, C_NEWTON, C_NEWTON_FAIL = 7, 8, 9
 EXIT_SINGULAR_MATRIX = 104
 
 #: Work arrays of the compiled Radau loop (allocated once per integrator).
@@ -632,6 +638,7 @@ def advance(cd, states, ws, rw, t, y, t_stop, t_bound, h_abs, max_steps, rtol, a
                 have_lu = False
                 rejected = True
                 counters[C_REJ] += 1
+                counters[C_NEWTON_FAIL] += 1
                 continue
             for j in range(n):
                 y_new[j] = y[j] + Z[2, j]
@@ -809,7 +816,7 @@ class CompiledRadau(Integrator):
             err=np.zeros(n), tmp=np.zeros(n), qp=np.zeros(nq), vp=np.zeros(nv), Qa=np.zeros(nv), Qb=np.zeros(nv),
             lam=np.zeros(max(m, 1)), Qpoly=np.zeros((n, 3)), info=np.zeros(10),
         )
-        self._cnt = np.zeros(9, np.int64)
+        self._cnt = np.zeros(10, np.int64)
         self._info = np.zeros(10)
         self._info[2] = np.nan  # no previous step
         self._info[4:6] = -1.0
@@ -912,6 +919,7 @@ class CompiledRadau(Integrator):
         c["n_factor"] = int(k[C_FACT])
         c["n_jac"] = int(k[C_JAC])
         c["n_newton"] = int(k[C_NEWTON])
+        c["n_newton_failures"] = int(k[C_NEWTON_FAIL])
         nq = self.system.n_q
         self.q, self.v = self._y[:nq].copy(), self._y[nq:].copy()
         self.a = self._rw.f[nq:].copy()

@@ -50,11 +50,18 @@ keeps the step when the predicted change is below 20 %).  When the iteration fai
 Jacobian, it restarts from the same starting guess with a fresh one; when it fails with a fresh
 one, the step is halved (RADAU5).
 
-Besides the common counters, a run reports ``n_newton_failures``: the attempts whose Newton
-iteration failed even with a fresh Jacobian, each followed by halving the step (the rest of
-``n_rejected`` are error-test rejections).  On the 8-link penalty chain (k = 1e6) about 60 % of the
-rejections are Newton failures, as for scipy's Radau on the same equations: the stiff springs
-rotate with the links within a step, so the Jacobian of the step start goes stale.
+Newton failures and the step size: on stiff springs that rotate with the bodies (the penalty
+chain, a wheel–rail contact) the Jacobian of the step start goes stale within a step, so the
+contraction rate ``θ`` of the simplified Newton iteration grows with h; RADAU5's controller, which
+knows only the error estimate, then enlarges the step until the iteration fails and halves it,
+over and over (8-link penalty chain, k = 1e8 N/m, rtol 3e-4: 1727 Newton failures in 1356 accepted
+steps).  After the idea of Gustafsson & Söderlind (1997), to keep the convergence rate in check
+through the step size, an accepted step whose last rate exceeds ``NEWTON_RATE_HOLD`` = 0.1 is not
+enlarged (reductions still apply).  Measured on that chain: Newton failures 1727 → 512, right-hand
+sides 24 527 → 16 297, factorisations 6258 → 2324 (k = 1e8); 129 → 82 failures and 5 % less work at
+k = 1e6; identical step sequences on the rigid chain and at k = 1e4, where θ stays small.  A run
+reports ``n_newton_failures`` (attempts whose iteration failed even with a fresh Jacobian, each
+followed by halving the step; the rest of ``n_rejected`` are error-test rejections).
 
 Error control is RADAU5's (estimate ``(γ₀/h − J)⁻¹ (f(y₀) + Σ eᵢ Zᵢ / h)``, norm
 ``‖e / (atol + rtol |y|)‖_RMS``); there is no stability limit and so no stiffness warning.
@@ -66,6 +73,8 @@ References
 ----------
 E. Hairer, G. Wanner, *Solving Ordinary Differential Equations II*, 2nd ed., Springer, 1996,
 Sec. IV.8 (RADAU5) and VII.1 (index-1 formulation of mechanical systems).
+K. Gustafsson, G. Söderlind, "Control strategies for the iterative solution of nonlinear equations
+in ODE solvers", SIAM J. Sci. Comput. 18 (1997) 23–40.
 G. H. Golub, C. F. Van Loan, *Matrix Computations*, 4th ed., 2013, Sec. 4.3 (band LU).
 E. Cuthill, J. McKee, "Reducing the bandwidth of sparse symmetric matrices", Proc. 24th ACM
 National Conference (1969) 157–172.
@@ -106,6 +115,8 @@ _inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="alwa
 
 # counters beyond compiled_rk's layout (steps, rejected, rhs, factorisations, ...)
 C_JAC, C_NEWTON, C_NEWTON_FAIL = 7, 8, 9
+# contraction rate of the simplified Newton iteration above which an accepted step is not enlarged
+NEWTON_RATE_HOLD = 0.1
 EXIT_SINGULAR_MATRIX = 104
 
 #: Work arrays of the compiled Radau loop (allocated once per integrator).
@@ -684,6 +695,8 @@ def advance(cd, states, ws, rw, t, y, t_stop, t_bound, h_abs, max_steps, rtol, a
             factor = min(1.0, factor)
         if not recompute_jac and factor < 1.2:
             factor = 1.0
+        if rate > NEWTON_RATE_HOLD:  # slow contraction: do not enlarge h (see the module docstring)
+            factor = min(factor, 1.0)
         # dense output polynomial (Q = Zᵀ P) and the start state of the step
         for j in range(n):
             y_old[j] = y[j]

@@ -31,17 +31,48 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .dynamics import project_velocities
-from .errors import AssemblyError, InputError
+from .errors import AssemblyError, InputError, ModelError
 from .system import ConstrainedSystem, as_dense
 
 Array = NDArray[np.float64]
 
-__all__ = ["assemble_state", "assemble", "newton_positions", "truncated_svd", "coordinate_scale"]
+__all__ = ["assemble_state", "assemble", "check_initial_state", "newton_positions", "truncated_svd",
+           "coordinate_scale"]
 
 
 def coordinate_scale(q: Array) -> float:
     """``max(1, max|q|)``: the scale of absolute tolerances on positions."""
     return max(1.0, float(np.max(np.abs(q)))) if len(q) else 1.0
+
+
+def check_initial_state(system: ConstrainedSystem, t: float, q: Array, v: Array, tol: float = 1e-9,
+                        owner: str = "", remedy: str = "") -> None:
+    """Raise :class:`core.errors.ModelError` when ``(q, v)`` violates the constraints at time ``t``.
+
+    Positions: ``|Φ_i(t, q)| ≤ tol·max(1, max|q|)`` for every row; velocities:
+    ``|(Φ_q v − ν)_i| ≤ tol·max(1, max|v|)``.  The message names the worst row by its constraint
+    name, its residual, the number of rows over the tolerance, ``owner`` (who supplied the state)
+    and ``remedy`` (what to do about it).  Non-finite constraint values are reported too.
+    """
+    if system.n_c == 0:
+        return
+    who = f"{owner}: " if owner else ""
+    names = list(getattr(system, "constraint_names", [])) or [f"row {i}" for i in range(system.n_c)]
+    phi = np.asarray(system.Phi(t, q), float)
+    if not np.all(np.isfinite(phi)):
+        k = int(np.flatnonzero(~np.isfinite(phi))[0])
+        raise ModelError(f"{who}constraint {names[k]!r} is not finite at the initial configuration")
+    bad = np.flatnonzero(np.abs(phi) > tol * coordinate_scale(q))
+    if len(bad):
+        worst = bad[np.argmax(np.abs(phi[bad]))]
+        raise ModelError(f"{who}inconsistent initial positions; constraint {names[worst]!r} is violated by "
+                         f"{phi[worst]:.3e} ({len(bad)} rows over tolerance {tol:g}). {remedy}".rstrip())
+    vv = np.asarray(system.velocity_violation(t, q, v), float)
+    bad = np.flatnonzero(~(np.abs(vv) <= tol * coordinate_scale(v)))
+    if len(bad):
+        worst = bad[np.argmax(np.nan_to_num(np.abs(vv[bad]), nan=np.inf))]
+        raise ModelError(f"{who}inconsistent initial velocities; constraint {names[worst]!r} has velocity "
+                         f"residual {vv[worst]:.3e} ({len(bad)} rows over tolerance {tol:g}). {remedy}".rstrip())
 
 
 def truncated_svd(J, rank_tol: float = 1e-6, max_rank: int | None = None):

@@ -158,7 +158,9 @@ def _cmd_bench(args: argparse.Namespace) -> int:
                            report=lambda s: print(s, file=sys.stderr))
     written = write_work_precision(df, args.out)
     summary = fastest_to_tolerance(df)
-    print(summary.to_markdown(index=False, floatfmt=".3g"))
+    from .results import markdown_table
+
+    print(markdown_table(summary, floatfmt=".3g"))
     print(f"mbsuite bench: {len(df)} runs of {len(expanded)} problem(s) in {time.perf_counter() - start:.1f} s "
           f"-> {args.out} ({len(written) - 1} tables + figures, summary)")
     return 0

@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import frames
 from .assembly import assemble as assemble_model
+from .assembly import check_initial_state
 from .bodies import PLANAR, SPATIAL, Body, BodyStates, Space
 from .constraints import PrimitiveKind
 from .errors import ModelError, RedundantConstraintError
@@ -223,6 +224,16 @@ class ModelBuilder:
                 J = np.diag(J)
             if J.shape != (3, 3) or not np.allclose(J, J.T) or np.any(np.linalg.eigvalsh(J) < -1e-15):
                 raise ModelError(f"body {name!r}: inertia must be a symmetric positive semi-definite 3×3 tensor (or 3 principal moments)")
+            # a rigid body's principal moments satisfy the triangle inequality J_a ≤ J_b + J_c
+            # (J_a = ∫(y² + z²) dm etc.; Goldstein, Classical Mechanics, 3rd ed., Sec. 5.3); equality:
+            # a flat body; a tensor that violates it belongs to no mass distribution
+            Jp = np.linalg.eigvalsh(J)
+            slack = Jp[0] + Jp[1] - Jp[2]
+            if slack < -1e-9 * max(float(Jp[2]), np.finfo(float).tiny):
+                raise ModelError(
+                    f"body {name!r}: principal moments of inertia {Jp[0]:.6g}, {Jp[1]:.6g}, {Jp[2]:.6g} kg m² violate "
+                    f"the triangle inequality (largest {Jp[2]:.6g} > {Jp[0]:.6g} + {Jp[1]:.6g}): no rigid body has "
+                    "this inertia (check the units and which moments were given)")
             p = np.array([1.0, 0, 0, 0]) if orientation is None else np.asarray(orientation, float)
             if p.shape != (4,) or not abs(np.linalg.norm(p) - 1.0) <= 1e-6:  # `not <=` also rejects NaN
                 raise ModelError(f"body {name!r}: orientation must be 4 Euler parameters of unit norm, got {np.asarray(orientation).tolist()}")
@@ -889,29 +900,8 @@ class Model(ConstrainedSystem):
 
     # --- build-time checks -------------------------------------------------------------------
     def _check_initial(self, tol: float) -> None:
-        if self.n_c == 0:
-            return
-        phi = self.Phi(0.0, self.q0)
-        if not np.all(np.isfinite(phi)):
-            k = int(np.flatnonzero(~np.isfinite(phi))[0])
-            raise ModelError(f"model {self.name!r}: constraint {self.constraint_names[k]!r} is not finite at the initial configuration")
-        scale = max(1.0, float(np.max(np.abs(self.q0))) if self.n_q else 1.0)
-        bad = np.flatnonzero(np.abs(phi) > tol * scale)
-        if len(bad):
-            worst = bad[np.argmax(np.abs(phi[bad]))]
-            raise ModelError(
-                f"model {self.name!r}: inconsistent initial positions; constraint {self.constraint_names[worst]!r} "
-                f"is violated by {phi[worst]:.3e} ({len(bad)} rows over tolerance {tol:g}). "
-                "Fix the initial configuration or build(assemble=True)."
-            )
-        vv = self.velocity_violation(0.0, self.q0, self.v0)
-        bad = np.flatnonzero(np.abs(vv) > tol * max(1.0, float(np.max(np.abs(self.v0))) if self.n_v else 1.0))
-        if len(bad):
-            worst = bad[np.argmax(np.abs(vv[bad]))]
-            raise ModelError(
-                f"model {self.name!r}: inconsistent initial velocities; constraint {self.constraint_names[worst]!r} "
-                f"has velocity residual {vv[worst]:.3e}. Fix the initial velocities or build(assemble=True)."
-            )
+        check_initial_state(self, 0.0, self.q0, self.v0, tol, owner=f"model {self.name!r}",
+                            remedy="Fix the initial configuration or velocities, or build(assemble=True).")
 
     def dependent_constraints(self, q: Array | None = None, tol: float = 1e-9) -> list[int]:
         """Indices of constraint rows that are linear combinations of earlier-pivoted rows.

@@ -36,6 +36,7 @@ __all__ = [
     "SimulationResult",
     "environment_versions",
     "run_metadata",
+    "markdown_table",
     "write_table",
 ]
 
@@ -97,8 +98,47 @@ def write_table(
     csv_path = out / f"{stem}.csv"
     md_path = out / f"{stem}.md"
     df.to_csv(csv_path, index=keep_index)
-    md_path.write_text(df.to_markdown(index=keep_index, floatfmt=floatfmt) + "\n", encoding="utf-8")
+    md_path.write_text(markdown_table(df, index=keep_index, floatfmt=floatfmt) + "\n", encoding="utf-8")
     return {"csv": csv_path, "md": md_path}
+
+
+def _escape_cell(x):
+    """A cell or header as GitHub-flavoured Markdown table text: ``|`` escaped, line breaks as spaces."""
+    if isinstance(x, str):
+        return x.replace("\\|", "|").replace("|", "\\|").replace("\r\n", " ").replace("\n", " ")
+    if isinstance(x, tuple):  # MultiIndex labels
+        return tuple(_escape_cell(v) for v in x)
+    return x
+
+
+def markdown_table(df: pd.DataFrame, index: bool = False, floatfmt: str = ".6g") -> str:
+    """A DataFrame as a GitHub-flavoured Markdown table that renders as the table it is.
+
+    A ``|`` inside a header or a cell (``max |Φ| [m]``) would end the cell; it is written ``\\|``
+    (GitHub Flavored Markdown spec, "Tables (extension)"), and a line break inside a cell becomes a space.  Numbers are
+    formatted with ``floatfmt``.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+    index : bool
+        Write the index as the first column(s).
+    floatfmt : str
+        Format spec for floats (passed to tabulate).
+
+    Returns
+    -------
+    str
+    """
+    out = df.copy()
+    out.columns = [_escape_cell(c) for c in out.columns]
+    if index:
+        out.index = out.index.map(_escape_cell)
+        out.index.names = [_escape_cell(n) for n in out.index.names]
+    for c in out.columns:
+        if out[c].dtype == object or pd.api.types.is_string_dtype(out[c].dtype):
+            out[c] = out[c].map(_escape_cell)
+    return out.to_markdown(index=index, floatfmt=floatfmt)
 
 
 # ----------------------------------------------------------------------------------
@@ -493,7 +533,12 @@ class SimulationResult:
         return df
 
     def summary(self) -> pd.DataFrame:
-        """Return a one-row DataFrame: status, metadata, counters, final and max violations."""
+        """Return a one-row DataFrame: status, metadata, counters, final and max violations, energy drift.
+
+        Energy (conservative systems): ``max |E − E0|`` [J], the scale of :meth:`energy_table`
+        (``|E0|``, or ``max |E|`` when ``E0 = 0``) and the relative drift ``max |E − E0| / |E0|``,
+        which is NaN when ``E0 = 0`` (read the absolute drift against the scale then).
+        """
         row: dict[str, Any] = {
             "status": self.status,
             "message": self.message,
@@ -507,8 +552,13 @@ class SimulationResult:
         row["max " + POSITION_VIOLATION_COLUMN] = float(np.nanmax(self.position_violation))
         row["max " + VELOCITY_VIOLATION_COLUMN] = float(np.nanmax(self.velocity_violation))
         if self.energy is not None:
+            # the absolute drift always, with its scale; the relative drift only against a non-zero E0
+            # (against the run's own max |E| a drift from E0 = 0 would always read 1)
             energy_df = self.energy_table()
-            row["max |relative energy drift| [-]"] = float(np.nanmax(np.abs(energy_df["relative energy drift [-]"])))
+            row["max |energy drift| [J]"] = float(np.nanmax(np.abs(energy_df["energy drift [J]"])))
+            row["energy scale [J]"] = float(energy_df.attrs["energy scale [J]"])
+            row["max |relative energy drift| [-]"] = (
+                float(np.nanmax(np.abs(energy_df["relative energy drift [-]"]))) if self.energy[0] != 0 else np.nan)
         df = pd.DataFrame([row])
         df.attrs["meta"] = dict(self.meta)
         return df

@@ -39,7 +39,7 @@ __all__ = ["simulate"]
 def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] = "rk45-projection", *,
              t_eval=None, n_output: int = 201, q0=None, v0=None, rtol: float = 1e-6, atol: float = 1e-8,
              h: float | None = None, max_step: float = np.inf, progress: bool | None = False,
-             compute_multipliers: bool = True, **options):
+             compute_multipliers: bool = True, assemble: bool = False, **options):
     """Integrate ``system`` over ``t_span`` and return a :class:`core.results.SimulationResult`.
 
     Output is sampled at ``t_eval`` (default ``n_output`` equally spaced times) from each step's
@@ -51,14 +51,27 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
     A run that fails (NaN, divergence, unmet tolerance, exception) returns with
     ``status == "failed"``, the message saying where, all output computed up to that point and, as
     its last row, the last good state at the time where the run stopped.
+
+    Initial states given as ``q0``/``v0`` get the consistency check of ``build()``: a violated
+    constraint raises :class:`core.errors.ModelError` naming it; with ``assemble=True`` they are
+    first made consistent by :func:`core.assembly.assemble_state` (Gauss–Newton on the positions,
+    mass-weighted projection of the velocities).  ``n_output`` must be at least 1 (with one
+    output time, the end state only).
     """
     cls = get_method(method)
     t0, t_end = map(float, t_span)
     if t_eval is None:
-        t_eval = np.linspace(t0, t_end, n_output)
+        if isinstance(n_output, bool) or not isinstance(n_output, (int, np.integer)) or n_output < 1:
+            raise InputError(f"simulate: n_output must be an integer >= 1 (the number of equally spaced output "
+                             f"times, t0 and t_end included), got {n_output!r}")
+        t_eval = np.linspace(t0, t_end, n_output) if n_output > 1 else np.array([t_end])
     t_eval = np.asarray(t_eval, float)
     if np.any(np.diff(t_eval) <= 0) or t_eval[0] < t0 - 1e-14 or t_eval[-1] > t_end + 1e-12:
         raise InputError(f"t_eval must be strictly increasing within t_span {t_span}")
+    if assemble and (q0 is not None or v0 is not None) and isinstance(system, ConstrainedSystem):
+        from .assembly import assemble_state
+
+        q0, v0 = assemble_state(system, q0, v0, t=t0)
     integ = cls(system, (t0, t_end), q0, v0, rtol=rtol, atol=atol, h=h, max_step=max_step, **options)
     ts, qs, vs, lams = [], [], [], []
     k = 0

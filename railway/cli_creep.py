@@ -82,7 +82,7 @@ def add_creep_curve_parser(railway_subparsers) -> argparse.ArgumentParser:
 def run_creep_curve(args: argparse.Namespace) -> int:
     """Run the ``creep-curve`` command; returns the exit code (0 ok, 2 bad input)."""
     from core.plot import save_figure
-    from core.results import write_table
+    from core.results import markdown_table, write_table
 
     from .creep_curve import creep_curve, plot_creep_curve
     from .forces import wheel_rail_curvatures
@@ -125,7 +125,7 @@ def run_creep_curve(args: argparse.Namespace) -> int:
     pick = np.unique(np.linspace(0, args.n - 1, 5).round().astype(int))
     rows = df.groupby("model", sort=False).nth(pick)
     cols = ["model", swept, "Fx [N]", "Fy [N]", "Mz [N m]"]
-    print(rows[cols].to_markdown(index=False, floatfmt=".4g"))
+    print(markdown_table(rows[cols], floatfmt=".4g"))
     r = df.iloc[0]
     print(f"contact: N = {N:g} N, a = {r['a [m]']:.4g} m, b = {r['b [m]']:.4g} m, "
           f"G = {r['G [Pa]']:.4g} Pa, nu = {args.nu}, mu = {args.mu}")

@@ -138,7 +138,7 @@ def write_work_precision(df: pd.DataFrame, out_dir: str | Path, prefix: str = "w
         ``{problem: {"csv": path, "md": path, "png": path}, "summary": {...}}``.
     """
     from ..plot import save_figure
-    from ..results import write_table
+    from ..results import markdown_table, write_table
 
     out = Path(out_dir)
     written: dict[str, dict[str, Path]] = {}
@@ -146,7 +146,7 @@ def write_work_precision(df: pd.DataFrame, out_dir: str | Path, prefix: str = "w
         sub = df[df["problem"] == prob].reset_index(drop=True)
         stem = f"{prefix}_{prob}"
         paths = write_table(sub, out, stem)
-        md = _markdown_table(sub).to_markdown(index=False, floatfmt=".3g")
+        md = markdown_table(_markdown_table(sub), floatfmt=".3g")
         paths["md"].write_text(md + "\n", encoding="utf-8")
         paths["png"] = save_figure(work_precision_figure(sub), out, stem)
         written[prob] = paths

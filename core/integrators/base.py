@@ -32,6 +32,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
+from ..assembly import check_initial_state
 from ..errors import RUN_FAILURES, InputError, NumericalFailure, UnknownOptionError
 from ..registry import Registry
 from ..system import ConstrainedSystem
@@ -84,6 +85,10 @@ class Integrator:
 
     def __init__(self, system: ConstrainedSystem, t_span, q0=None, v0=None, *, rtol: float = 1e-6,
                  atol: float = 1e-8, h: float | None = None, max_step: float = np.inf, **options):
+        if not isinstance(system, ConstrainedSystem):
+            hint = (": call build() on the ModelBuilder first (model = builder.build())" if hasattr(system, "build")
+                    else " (a built Model or another ConstrainedSystem)")
+            raise InputError(f"{self.name}: expected a built model, got a {type(system).__name__}{hint}")
         t0, t_end = map(float, t_span)
         if not t_end > t0:
             raise InputError(f"{self.name}: t_span must have t_end > t0, got {t_span}")
@@ -94,8 +99,15 @@ class Integrator:
         self.system = system
         self.t0, self.t_bound = t0, t_end
         self.t = self.t_old = t0
-        self.q = np.array(system.q0 if q0 is None else q0, dtype=float)
-        self.v = np.array(system.v0 if v0 is None else v0, dtype=float)
+        self.q = _initial_vector(self.name, system, "q0", system.q0 if q0 is None else q0, system.n_q,
+                                 "coordinates")
+        self.v = _initial_vector(self.name, system, "v0", system.v0 if v0 is None else v0, system.n_v,
+                                 "velocity coordinates")
+        if q0 is not None or v0 is not None:
+            # a state given here gets the check build() gives the model's own (simulate(assemble=True)
+            # makes it consistent first)
+            check_initial_state(system, t0, self.q, self.v, owner=f"{self.name}, model {system.name!r}",
+                                remedy="Give consistent q0/v0, or simulate(..., assemble=True) to assemble them.")
         self.q_old, self.v_old = self.q.copy(), self.v.copy()
         self.a = self.a_old = None
         self.lam = None
@@ -230,3 +242,20 @@ def get_method(method: str | type[Integrator]) -> type[Integrator]:
     if not isinstance(method, str):
         raise InputError(f"method must be an integrator name or an Integrator subclass, got {method!r}")
     return METHODS[method]
+
+
+def _initial_vector(method: str, system, what: str, value, n: int, kind: str) -> Array:
+    """``value`` as a float vector of length ``n``, or an :class:`InputError` naming what is wrong."""
+    try:
+        x = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{method}: {what} must be an array of {n} numbers for model {system.name!r}, "
+                         f"got {type(value).__name__} ({exc})") from None
+    if x.shape != (n,):
+        names = list(getattr(system, "coordinate_names", []) if what == "q0" else [])
+        shown = (": " + ", ".join(names[:6]) + (", ..." if len(names) > 6 else "")) if names else ""
+        raise InputError(f"{method}: {what} has shape {x.shape}, model {system.name!r} has {n} {kind}{shown}")
+    if not np.all(np.isfinite(x)):
+        k = int(np.flatnonzero(~np.isfinite(x))[0])
+        raise InputError(f"{method}: {what}[{k}] is {x[k]}; initial states must be finite")
+    return x

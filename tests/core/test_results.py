@@ -20,7 +20,7 @@ from core.plot import (
     plot_xy_path,
     save_figure,
 )
-from core.results import SimulationResult, environment_versions, run_metadata, write_table
+from core.results import SimulationResult, environment_versions, markdown_table, run_metadata, write_table
 
 OMEGA = 2.0  # rad/s
 MASS = 3.0  # kg
@@ -105,6 +105,74 @@ def test_energy_table_with_zero_initial_energy_uses_max_scale():
     res = SimulationResult(t=t, q=np.zeros((5, 1)), v=np.zeros((5, 1)), status="finished", energy=energy)
     df = res.energy_table()
     np.testing.assert_allclose(df["relative energy drift [-]"], energy / 4.0)
+
+
+def test_summary_energy_drift_from_zero_initial_energy_is_absolute():
+    """E0 = 0 (e.g. a pendulum released from its pivot height): the summary gives the absolute drift and
+    its scale; a relative drift against the run's own maximum would read 1 whatever the error."""
+    t = np.linspace(0, 1, 4)
+    res = SimulationResult(t=t, q=np.zeros((4, 1)), v=np.zeros((4, 1)), status="finished",
+                           energy=np.array([0.0, 1e-9, -3e-9, 2e-9]))
+    row = res.summary().iloc[0]
+    assert row["max |energy drift| [J]"] == pytest.approx(3e-9, rel=1e-12)
+    assert row["energy scale [J]"] == pytest.approx(3e-9, rel=1e-12)
+    assert np.isnan(row["max |relative energy drift| [-]"])
+    res = SimulationResult(t=t, q=np.zeros((4, 1)), v=np.zeros((4, 1)), status="finished",
+                           energy=np.array([-2.0, -2.0 + 1e-6, -2.0, -2.0 - 4e-6]))
+    row = res.summary().iloc[0]
+    assert row["max |energy drift| [J]"] == pytest.approx(4e-6, rel=1e-9)
+    assert row["max |relative energy drift| [-]"] == pytest.approx(2e-6, rel=1e-9)
+
+
+def _gfm_table(text: str) -> tuple[list[str], list[list[str]]]:
+    """Header cells and body rows of the one GitHub-flavoured Markdown table in ``text``, as a GFM
+    parser (markdown-it-py, CommonMark + the table extension) reads them."""
+    from markdown_it import MarkdownIt
+
+    tokens = MarkdownIt("commonmark").enable("table").parse(text)
+    assert sum(tok.type == "table_open" for tok in tokens) == 1, "the text is not one Markdown table"
+    header, rows, cell = [], [], None
+    for tok in tokens:
+        if tok.type == "tr_open":
+            rows.append([])
+        elif tok.type in ("th_open", "td_open"):
+            cell = tok.type
+        elif tok.type == "inline" and cell is not None:
+            rows[-1].append(tok.content)
+            cell = None
+    header, body = rows[0], rows[1:]
+    return header, body
+
+
+def test_markdown_tables_render_with_pipes_in_headers_cells_and_index(tmp_path):
+    """Headers such as "max |Φ| [m]" and cells holding "|" must not split cells: every row of the
+    written .md parses, with a GFM parser, into exactly the DataFrame's columns, with the text unchanged."""
+    df = pd.DataFrame({"max |Φ| [m]": [1.5e-10, 2.0], "status": ["finished", "a | b\nnext line"],
+                       "note": ["|x|", "already \\| escaped"]},
+                      index=pd.Index(["run |1|", "run 2"], name="case |k|"))
+    paths = write_table(df, tmp_path, "pipes")
+    header, body = _gfm_table(paths["md"].read_text())
+    assert header == ["case |k|", "max |Φ| [m]", "status", "note"]
+    assert len(body) == 2 and all(len(r) == 4 for r in body)
+    assert body[0][0] == "run |1|" and body[0][3] == "|x|"
+    assert body[1][2] == "a | b next line" and body[1][3] == "already | escaped"
+    assert float(body[0][1]) == pytest.approx(1.5e-10)
+    # the CSV keeps the text as it is
+    assert pd.read_csv(paths["csv"])["status"].iloc[1] == "a | b\nnext line"
+    # the same function serves printed tables
+    header, _ = _gfm_table(markdown_table(df.reset_index()))
+    assert header[1] == "max |Φ| [m]"
+
+
+def test_simulation_summary_table_renders(tmp_path):
+    """The summary of a real run (its headers hold |·|) written by write_table parses as a table."""
+    from core import models
+    from core.integrators import simulate
+
+    res = simulate(models.simple_pendulum(), (0.0, 0.2), "rk45-projection", n_output=5)
+    summ = res.summary()
+    header, body = _gfm_table(write_table(summ, tmp_path, "summary")["md"].read_text())
+    assert header == list(summ.columns) and len(body) == 1 and len(body[0]) == len(header)
 
 
 def test_reactions_summary_final_state_and_frame():

@@ -90,6 +90,9 @@ __all__ = [
 ]
 
 
+EQUILIBRIUM_TOL = 1e-6  # eigen(): relative unbalanced force above which the state is not an equilibrium
+
+
 class AnalysisWarning(UserWarning):
     """An analysis stopped early; the partial result carries ``attrs['status'] == 'failed'``."""
 
@@ -653,6 +656,12 @@ class LinearizedSystem:
     K_geometric : ndarray, shape (n_dof, n_dof)
         The constraint-force part ``Nᵀ ∂(Φ_qᵀλ)/∂q N`` of ``K``.
     velocity_names : list of str
+    acceleration : ndarray, shape (n_v,)
+        Accelerations ``a`` of the index-1 equations at the linearisation state.
+    equilibrium_residual : float
+        ``‖M a‖_∞ / max(‖Q‖_∞, ‖Φ_qᵀλ‖_∞)``: the unbalanced generalized force relative to the forces
+        acting; zero at an equilibrium (or a steady motion with ``a = 0``).  Above 1e-6,
+        :func:`eigen` warns that the modes belong to an accelerating state.
     """
 
     M: Array
@@ -666,6 +675,8 @@ class LinearizedSystem:
     lam: Array
     K_geometric: Array
     velocity_names: list[str]
+    acceleration: Array | None = None
+    equilibrium_residual: float = 0.0
 
     @property
     def n_dof(self) -> int:
@@ -717,9 +728,15 @@ def linearize(system: ConstrainedSystem, q: ArrayLike | None = None, v: ArrayLik
     Mr = N.T @ M @ N
     C = -N.T @ Qv @ N
     Kr = N.T @ (-Qq + Kg + Km) @ N
+    Q = np.asarray(system.Q(t, q, v), float)
+    react = as_dense(system.Phi_q(t, q)).T @ lam_kkt if system.n_c else np.zeros(system.n_v)
+    force_scale = max(float(np.max(np.abs(Q), initial=0.0)), float(np.max(np.abs(react), initial=0.0)))
+    unbalanced = float(np.max(np.abs(M @ a), initial=0.0))
+    residual = unbalanced / force_scale if force_scale > 0 else (0.0 if unbalanced == 0 else np.inf)
     return LinearizedSystem(
         M=0.5 * (Mr + Mr.T), D=0.5 * (C + C.T), G=0.5 * (C - C.T), K=Kr, N=N, q=q, v=v, t=float(t),
-        lam=lam, K_geometric=N.T @ Kg @ N, velocity_names=_names(system)[1],
+        lam=lam, K_geometric=N.T @ Kg @ N, velocity_names=_names(system)[1], acceleration=a,
+        equilibrium_residual=residual,
     )
 
 
@@ -741,6 +758,13 @@ def eigen(system: ConstrainedSystem | LinearizedSystem, q: ArrayLike | None = No
         shape ``N φ`` mapped back to velocity space, scaled to unit largest component.
     """
     lin = system if isinstance(system, LinearizedSystem) else linearize(system, q, v, t, lam)
+    if lin.equilibrium_residual > EQUILIBRIUM_TOL and lin.acceleration is not None:
+        k = int(np.argmax(np.abs(lin.acceleration)))
+        warnings.warn(
+            f"eigen: the state is not an equilibrium (unbalanced generalized force {lin.equilibrium_residual:.3g} "
+            f"of the forces acting; largest acceleration {lin.acceleration[k]:.3g} in {lin.velocity_names[k]!r}); "
+            "the modes describe the linearisation about an accelerating state. Find the equilibrium first "
+            "(static_equilibrium).", AnalysisWarning, stacklevel=2)
     n = lin.n_dof
     if n == 0:
         empty = pd.DataFrame(columns=["real [1/s]", "imag [rad/s]", "frequency [Hz]", "natural frequency [Hz]", "damping ratio [-]"])
@@ -770,5 +794,5 @@ def eigen(system: ConstrainedSystem | LinearizedSystem, q: ArrayLike | None = No
         if abs(modes[j, k]) > 0:
             modes[:, k] /= modes[j, k]
     mdf = pd.DataFrame(modes, index=lin.velocity_names, columns=[f"mode {k}" for k in range(modes.shape[1])])
-    table.attrs.update(analysis="eigen", n_dof=n)
+    table.attrs.update(analysis="eigen", n_dof=n, equilibrium_residual=lin.equilibrium_residual)
     return table, mdf

@@ -102,3 +102,24 @@ def test_energy_drift_of_a_run_from_zero_energy_is_absolute():
     row = res.summary().iloc[0]
     assert np.isnan(row["max |relative energy drift| [-]"])
     assert row["max |energy drift| [J]"] < 1e-6 * row["energy scale [J]"] or row["max |energy drift| [J]"] < 1e-7
+
+
+def test_eigen_away_from_equilibrium_says_so():
+    """A rod pendulum held horizontal is not an equilibrium: eigen() warns and reports the relative
+    unbalanced force (0.75 for the free rod: the angular acceleration 3g/2L against the gravity m g); hanging, it is
+    silent and the residual is round-off."""
+    import warnings
+
+    from core.analysis import AnalysisWarning, eigen
+
+    horizontal = models.simple_pendulum(bob="rod", angle0=np.pi / 2)
+    with pytest.warns(AnalysisWarning, match=r"not an equilibrium .*largest acceleration .* in 'link1"):
+        table, _ = eigen(horizontal)
+    assert table.attrs["equilibrium_residual"] == pytest.approx(0.75, rel=1e-9)
+    hanging = models.simple_pendulum(bob="rod", angle0=0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        table, _ = eigen(hanging)
+    assert table.attrs["equilibrium_residual"] < 1e-12
+    # the compound pendulum's frequency: sqrt(m g l/2 / (m l²/3)) for a 1 m rod
+    assert table["natural frequency [Hz]"].iloc[0] == pytest.approx(np.sqrt(1.5 * 9.81) / (2 * np.pi), rel=1e-9)

@@ -57,7 +57,7 @@ def _body(b, rng, name):
     if b.space.dim == 2:
         return b.add_body(name, rng.uniform(0.5, 2.0), rng.uniform(0.05, 0.3), rng.uniform(-1, 1, 2),
                           orientation=rng.uniform(-np.pi, np.pi))
-    J = np.diag(rng.uniform(0.05, 0.3, 3))
+    J = np.diag(rng.uniform(0.1, 0.2, 3))  # principal moments of a rigid body: J_a <= J_b + J_c
     R = frames.euler_to_matrix(frames.axis_angle_to_euler(_unit(rng), rng.uniform(0, np.pi)))
     p = frames.axis_angle_to_euler(_unit(rng), rng.uniform(-np.pi, np.pi))
     return b.add_body(name, rng.uniform(0.5, 2.0), R @ J @ R.T, rng.uniform(-1, 1, 3), orientation=p)

@@ -154,6 +154,9 @@ class HalfExplicitRK(Integrator):
         if not (_finite(F_prev) and _finite(J_prev)):
             return False, f"non-finite applied forces or constraint Jacobian at t = {t0:.6g} s"
         J0 = J_prev
+        # the acceleration of stage j solves M(Q_j) a_j = Q(Q_j, V_j) − Φ_q(Q_j)ᵀ λ_j (Brasey & Hairer 1993:
+        # f(Y_j, Z_j) at the stage), so a configuration-dependent M is evaluated at every stage
+        T_prev, Q_prev, M_prev = t0, q0, M
         Acc = []
         Qs, Vs = [], []
         Qi = Vi = None
@@ -166,11 +169,13 @@ class HalfExplicitRK(Integrator):
             if not (_finite(Ji) and _finite(nui) and _finite(Qi)):
                 return False, f"non-finite stage state or constraint terms at t = {Ti:.6g} s (stage {i + 1})"
             ha = h * row[i - 1]
-            Vi, mu = self._saddle.solve(Ti, Qi, Ji, M @ W + ha * F_prev, nui, G=J_prev)
+            Vi, mu = self._saddle.solve(T_prev, Q_prev, Ji, M_prev @ W + ha * F_prev, nui, G=J_prev)
             if not _finite(Vi):
                 return False, f"non-finite stage velocity at t = {Ti:.6g} s (stage {i + 1})"
             Acc.append((Vi - W) / ha)
             F_prev, J_prev = sys_.Q(Ti, Qi, Vi), Ji
+            T_prev, Q_prev = Ti, Qi
+            M_prev = M if sys_.mass_is_constant else self._saddle.mass(Ti, Qi)
             self.counters["n_rhs"] += 1
             if not _finite(F_prev):
                 return False, f"non-finite applied forces Q at t = {Ti:.6g} s (stage {i + 1})"

@@ -28,6 +28,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
+from .errors import MbsuiteError
+from .paths import output_folder
 from .scenes import Scene, SceneError, all_scenes, run_scene, tqdm_progress
 
 __all__ = ["COMMAND_ENTRY_POINT_GROUP", "build_parser", "main"]
@@ -83,8 +85,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
     from tqdm import tqdm
 
-    out_dir = Path(args.out)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    out_dir = output_folder(args.out)
     outcomes: dict[str, tuple[Scene, str]] = {}
     failed: list[str] = []
     bar = tqdm(selected, desc="scenes", unit="scene", disable=None)
@@ -166,6 +167,17 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1 (``--repeats 0`` would time nothing and report a median of nothing)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {value}")
+    return value
+
+
 def register_bench_command(subparsers) -> None:
     """Add ``mbsuite bench`` (the work-precision harness of :mod:`core.benchmarks`) to an argparse
     sub-parser collection; the package is imported only when the command runs."""
@@ -178,11 +190,11 @@ def register_bench_command(subparsers) -> None:
     p.add_argument("problems", nargs="*", metavar="PROBLEM", help="problem names, globs or sets (see --list)")
     p.add_argument("--list", action="store_true", help="list problems, sets and registered methods")
     p.add_argument("--methods", nargs="+", metavar="METHOD", help="integrator names (default: the grid's)")
-    p.add_argument("--repeats", type=int, default=3, help="solves per case; wall time = median (default 3)")
+    p.add_argument("--repeats", type=positive_int, default=3, help="solves per case; wall time = median (default 3)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--quick", action="store_true", help="CI-sized grids (about a minute for the quick set)")
     g.add_argument("--full", action="store_true", help="full grids: every method, rtol 1e-3..1e-10 (long)")
-    p.add_argument("-j", "--jobs", type=int, default=1, help="worker processes (default 1: serial)")
+    p.add_argument("-j", "--jobs", type=positive_int, default=1, help="worker processes (default 1: serial)")
     p.add_argument("-o", "--out", default="out/bench", help="output folder (default: %(default)s)")
     p.set_defaults(func=_cmd_bench, _parser=p)
 
@@ -194,6 +206,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Cartesian multibody dynamics suite: run scenes and domain tools.",
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    parser.add_argument("--traceback", action="store_true",
+                        help="on an error, show the Python traceback instead of the one-line message (debugging)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
     p_list = sub.add_parser("list", help="list the available scenes")
@@ -238,9 +252,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         code = func(args)
     except SystemExit as exc:  # parser.error() inside a command
         return exc.code if isinstance(exc.code, int) else EXIT_USAGE
-    except (ValueError, TypeError, FileNotFoundError) as exc:
-        # bad input (a value, a file): the message names it; no traceback for the user
-        print(f"mbsuite: error: {exc}", file=sys.stderr)
+    except (MbsuiteError, ValueError, TypeError, OSError) as exc:
+        # bad input (a value, a name, a file or folder): the message names it; one line, no traceback
+        # (--traceback shows it for debugging)
+        if getattr(args, "traceback", False):
+            raise
+        text = " ".join(str(exc).split()) or type(exc).__name__
+        if isinstance(exc, OSError) and not isinstance(exc, MbsuiteError):
+            text = f"{exc.strerror or type(exc).__name__}: {exc.filename}" if exc.filename else text
+        print(f"mbsuite: error: {text}", file=sys.stderr)
         return EXIT_USAGE
     return EXIT_OK if code is None else int(code)
 

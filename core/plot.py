@@ -15,6 +15,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .paths import output_folder, write_atomically
+
 if TYPE_CHECKING:  # pragma: no cover - typing only
     import pandas as pd
     from matplotlib.axes import Axes
@@ -250,8 +252,8 @@ def save_figure(fig: Figure, out_dir: str | Path, stem: str, dpi: int = 150, **s
     from .results import _check_stem
 
     _check_stem(stem)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder(out_dir)
     path = out / f"{stem}.png"
-    fig.savefig(path, dpi=dpi, bbox_inches="tight", **savefig_kw)
+    savefig_kw.setdefault("format", "png")  # the temporary file's name has no .png suffix
+    write_atomically(path, lambda p: fig.savefig(p, dpi=dpi, bbox_inches="tight", **savefig_kw))
     return path

@@ -31,6 +31,8 @@ from typing import Any, Literal, NamedTuple
 import numpy as np
 import pandas as pd
 
+from .paths import output_folder, write_atomically
+
 __all__ = [
     "FinalState",
     "SimulationResult",
@@ -92,13 +94,13 @@ def write_table(
     if not isinstance(df, pd.DataFrame):
         raise TypeError(f"write_table({stem!r}): expected a pandas DataFrame, got {type(df).__name__}")
     _check_stem(stem)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_folder(out_dir)
     keep_index = not (isinstance(df.index, pd.RangeIndex) and df.index.name is None)
     csv_path = out / f"{stem}.csv"
     md_path = out / f"{stem}.md"
-    df.to_csv(csv_path, index=keep_index)
-    md_path.write_text(markdown_table(df, index=keep_index, floatfmt=floatfmt) + "\n", encoding="utf-8")
+    md = markdown_table(df, index=keep_index, floatfmt=floatfmt) + "\n"
+    write_atomically(csv_path, lambda p: df.to_csv(p, index=keep_index))
+    write_atomically(md_path, lambda p: p.write_text(md, encoding="utf-8"))
     return {"csv": csv_path, "md": md_path}
 
 

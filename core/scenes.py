@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from .errors import NameTakenError
+from .paths import output_folder, write_atomically
 from .registry import Registry
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -238,6 +239,11 @@ def _scene_readme(scene: Scene, result: SceneResult, written: dict[str, list[Pat
     return "\n".join(lines).rstrip() + "\n"
 
 
+def _identity(path: Path) -> tuple[int, int, int]:
+    st = path.stat()
+    return st.st_ino, st.st_mtime_ns, st.st_size
+
+
 def run_scene(
     scene: Scene,
     out_dir: str | Path,
@@ -270,11 +276,13 @@ def run_scene(
     from .plot import save_figure
     from .results import write_table
 
-    folder = Path(out_dir) / scene.name
-    folder.mkdir(parents=True, exist_ok=True)
+    folder = output_folder(Path(out_dir) / scene.name, f"output folder of scene {scene.name!r}")
     error_file = folder / "error.txt"
     if error_file.exists():
         error_file.unlink()  # stale from an earlier failed run
+    # files of an earlier run, by identity (every writer replaces a file by a new one, so a rewritten
+    # file has a new inode and time stamp)
+    earlier = {p: _identity(p) for p in folder.iterdir() if p.is_file() and p.name != "error.txt"}
     try:
         result = scene.run(SceneContext(out_dir=folder, progress=progress, fast=fast))
         if not isinstance(result, SceneResult):
@@ -284,10 +292,17 @@ def run_scene(
             written["tables"] += list(write_table(df, folder, stem).values())
         for stem, fig in result.figures.items():
             written["figures"].append(save_figure(fig, folder, stem))
-        (folder / "README.md").write_text(_scene_readme(scene, result, written), encoding="utf-8")
+        readme = _scene_readme(scene, result, written)
+        write_atomically(folder / "README.md", lambda p: p.write_text(readme, encoding="utf-8"))
     except Exception as exc:
+        # files of an earlier run that this run did not rewrite would pass for its results: removed
+        stale = sorted(p.name for p, ident in earlier.items() if p.exists() and _identity(p) == ident)
+        for name in stale:
+            (folder / name).unlink()
+        note = (f"\nremoved {len(stale)} file(s) of an earlier run that this run did not rewrite: "
+                f"{', '.join(stale)}\n" if stale else "")
         error_file.write_text(
-            f"scene {scene.name!r} failed\n\n" + "".join(traceback.format_exception(exc)), encoding="utf-8"
+            f"scene {scene.name!r} failed\n{note}\n" + "".join(traceback.format_exception(exc)), encoding="utf-8"
         )
         raise SceneError(scene.name, folder, exc) from exc
     return result

@@ -15,8 +15,9 @@ import pytest
 
 import core
 from core import cli, scenes
-from core.errors import NameTakenError
+from core.errors import InputError, NameTakenError
 from core.registry import Registry
+from core.results import write_table
 from core.scenes import PluginLoadWarning, Scene, SceneError, SceneResult, run_scene
 
 REPO = Path(__file__).resolve().parents[2]
@@ -236,3 +237,60 @@ def test_bad_input_in_a_command_is_reported_without_traceback(capsys):
     err = capsys.readouterr().err
     assert code == 2
     assert "mbsuite: error: rail inclination -0.025" in err and "Traceback" not in err
+
+
+def test_failed_scene_removes_the_stale_files_of_an_earlier_run(tmp_path):
+    """A scene that fails must not leave an earlier run's tables and figures passing for its own: the
+    files it did not rewrite are removed and listed in error.txt."""
+    run_scene(OK_SCENE, tmp_path)
+    folder = tmp_path / "ok-scene"
+    earlier = sorted(p.name for p in folder.iterdir())
+    assert "parabola.csv" in earlier and "parabola.png" in earlier
+    failing = Scene("ok-scene", "Fails this time", "", _broken_scene)
+    with pytest.raises(SceneError):
+        run_scene(failing, tmp_path)
+    assert sorted(p.name for p in folder.iterdir()) == ["error.txt"]
+    text = (folder / "error.txt").read_text()
+    assert "removed 4 file(s) of an earlier run" in text and "parabola.csv" in text
+
+
+def test_output_path_that_is_a_file_is_a_one_line_error(registry, tmp_path, capsys):
+    blocker = tmp_path / "afile"
+    blocker.write_text("not a folder")
+    for out in (blocker, blocker / "sub"):
+        assert cli.main(["run", "ok-scene", "-o", str(out)]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and "afile" in err and "is a file" in err, err
+    with pytest.raises(InputError, match="it is a file"):
+        write_table(pd.DataFrame({"x [m]": [1.0]}), blocker, "t")
+    with pytest.raises(InputError, match="it is a file"):  # --traceback: the exception itself, for debugging
+        cli.main(["--traceback", "run", "ok-scene", "-o", str(blocker)])
+
+
+def test_bench_repeats_and_jobs_must_be_positive(capsys):
+    for args in (["bench", "--repeats", "0"], ["bench", "-j", "-1"], ["bench", "--repeats", "two"]):
+        assert cli.main(args) == 2
+        assert "expected an integer >= 1" in capsys.readouterr().err
+
+
+def test_library_errors_are_one_line(capsys, tmp_path):
+    """A bad creep-law name is a usage error (argparse's usage, then one line naming it), no traceback."""
+    code = cli.main(["railway", "creep-curve", "--model", "no-such-law", "-o", str(tmp_path)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and "Traceback" not in err and "no-such-law" in err.splitlines()[-1]
+
+
+def test_atomic_write_keeps_the_old_file_when_writing_fails(tmp_path):
+    from core.paths import write_atomically
+
+    target = tmp_path / "table.csv"
+    target.write_text("old, complete\n")
+
+    def failing(p):
+        p.write_text("half of a new fi")
+        raise OSError("disk full")
+
+    with pytest.raises(OSError, match="disk full"):
+        write_atomically(target, failing)
+    assert target.read_text() == "old, complete\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]

@@ -144,10 +144,10 @@ def _mbsuite_runner(model, method: str, fixed: bool):
             return np.full(2, np.nan), (time.perf_counter() - t0, time.process_time() - c0), False, \
                 f"{type(exc).__name__}: {exc}"
         wall = (time.perf_counter() - t0, time.process_time() - c0)
-        ok = res.status == "finished" and abs(res.t[-1] - 1.0) < 1e-12
+        ok = res.success and abs(res.t[-1] - 1.0) < 1e-12
         tip = chain_tip(model, res.q[-1]) if ok else np.full(2, np.nan)
         c = res.counters
-        return tip, wall, ok, f"steps={c['n_steps']} rhs={c['n_rhs']} fact={c['n_factor']} {res.message if not ok else ''}"
+        return tip, wall, ok, f"steps={c['n_steps']} rhs={c['n_rhs']} fact={c['n_factor']} {res.message if not ok or res.has_warnings else ''}"
 
     return run
 

@@ -43,6 +43,11 @@ __all__ = [
 ]
 
 TIME_COLUMN = "t [s]"
+#: Final statuses of a run (:attr:`SimulationResult.status`): reached the end time; reached it but a
+#: check found the result doubtful; stopped early.  Defined here, used by the integrators.
+STATUS_FINISHED, STATUS_WARNED, STATUS_FAILED = "finished", "finished with warnings", "failed"
+RUN_STATUSES = (STATUS_FINISHED, STATUS_WARNED, STATUS_FAILED)
+FINISHED_STATUSES = (STATUS_FINISHED, STATUS_WARNED)
 POSITION_VIOLATION_COLUMN = "position violation [m]"
 VELOCITY_VIOLATION_COLUMN = "velocity violation [m/s]"
 _VIOLATION_UNITS_NOTE = (
@@ -274,10 +279,13 @@ class SimulationResult:
         Generalized coordinates at the output times (m, rad, or 1 for Euler parameters).
     v : ndarray, shape (n_t, n_v)
         Generalized velocities (m/s, rad/s).
-    status : {"finished", "failed"}
-        Final status of the integrator.
+    status : {"finished", "finished with warnings", "failed"}
+        Final status: reached the end time; reached it but a check found the result doubtful
+        (see ``warnings``); or stopped early (the message says where and why).
     message : str, optional
-        Human-readable reason for the status (where and why a failed run stopped).
+        Human-readable reason for the status (where and why a failed run stopped; the warnings).
+    warnings : tuple of str, optional
+        What the checks of the integrator and of :func:`core.simulation.simulate` found doubtful.
     lam : ndarray, shape (n_t, n_c), optional
         Lagrange multipliers; None if the formulation does not produce them.
     counters : dict of str to int, optional
@@ -311,8 +319,9 @@ class SimulationResult:
     t: np.ndarray
     q: np.ndarray
     v: np.ndarray
-    status: Literal["finished", "failed"]
+    status: Literal["finished", "finished with warnings", "failed"]
     message: str = ""
+    warnings: tuple[str, ...] = ()
     lam: np.ndarray | None = None
     counters: dict[str, int] = field(default_factory=dict)
     meta: dict[str, Any] = field(default_factory=dict)
@@ -328,9 +337,12 @@ class SimulationResult:
     # -- validation ---------------------------------------------------------------
     def __post_init__(self) -> None:  # noqa: C901 - one check per field, in order
         put = object.__setattr__
-        if self.status not in ("finished", "failed"):
-            raise ValueError(f"SimulationResult.status must be 'finished' or 'failed', got {self.status!r}")
+        if self.status not in RUN_STATUSES:
+            raise ValueError(f"SimulationResult.status must be one of {RUN_STATUSES}, got {self.status!r}")
         put(self, "message", str(self.message))
+        put(self, "warnings", tuple(str(w) for w in self.warnings))
+        if self.warnings and self.status == STATUS_FINISHED:
+            put(self, "status", STATUS_WARNED)
 
         t = _readonly("t", self.t, 1)
         n_t = t.shape[0]
@@ -433,8 +445,13 @@ class SimulationResult:
     # -- scalar properties ---------------------------------------------------------
     @property
     def success(self) -> bool:
-        """True if the integrator reached the end time (``status == "finished"``)."""
-        return self.status == "finished"
+        """True if the integrator reached the end time, with or without warnings (read :attr:`status`)."""
+        return self.status in FINISHED_STATUSES
+
+    @property
+    def has_warnings(self) -> bool:
+        """True if the run reached the end time but a check found it doubtful (:attr:`warnings`)."""
+        return self.status == STATUS_WARNED
 
     @property
     def n_t(self) -> int:
@@ -544,6 +561,7 @@ class SimulationResult:
         row: dict[str, Any] = {
             "status": self.status,
             "message": self.message,
+            "n warnings": len(self.warnings),
             "n_t": self.n_t,
             "t_end [s]": float(self.t[-1]),
         }

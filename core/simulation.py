@@ -29,11 +29,61 @@ import numpy as np
 
 from .dynamics import accelerations
 from .errors import RUN_FAILURES, InputError
-from .integrators.base import STATUS_FAILED, STATUS_RUNNING, Integrator, get_method
+from .integrators.base import FINISHED_STATUSES, STATUS_FAILED, STATUS_RUNNING, Integrator, get_method
 from .results import SimulationResult, run_metadata
 from .system import ConstrainedSystem
 
-__all__ = ["simulate"]
+__all__ = ["simulate", "result_checks", "ENERGY_WARN_FACTOR", "VIOLATION_WARN_FACTOR"]
+
+#: A conservative run warns when ``max|E − E0| > ENERGY_WARN_FACTOR · (rtol · E_scale + atol · p_scale)``
+#: (see :func:`result_checks`).  On the pendulum study of the tests (every adaptive method,
+#: rtol 1e-2 … 1e-8) the drift relative to m g l was 0.3–7.5 times the angle error in rad, so a
+#: factor 3 flags every run whose error exceeds 10 × rtol.
+ENERGY_WARN_FACTOR = 3.0
+#: Any run warns when a position constraint is violated by more than
+#: ``VIOLATION_WARN_FACTOR · (atol + rtol · max(1, max|q|))`` at an output time.
+VIOLATION_WARN_FACTOR = 10.0
+
+
+def result_checks(system: ConstrainedSystem, t, Q, V, energy, position_violation, rtol: float,
+                  atol: float) -> list[str]:
+    r"""Checks of a finished run against physics that need no reference; one message per failed check.
+
+    * **Energy** (``system.is_conservative``): the total energy of the exact motion is constant, so
+      ``max|E − E0| > ENERGY_WARN_FACTOR · (rtol · E_scale + atol · p_scale)`` is an error the
+      tolerances did not allow, with ``E_scale = max_t ½ vᵀM v`` (the peak kinetic energy:
+      independent of the potential's datum; ``|E0|`` for a run at rest) and
+      ``p_scale = max_t (‖M v‖₁ + ‖Q‖₁)``, the change of ``E`` per unit absolute error of every
+      coordinate (``∂E/∂v = M v``, ``∂E/∂q = −Q`` for conservative forces).
+    * **Constraints**: the exact motion has ``Φ = 0``; an output with
+      ``‖Φ‖∞ > VIOLATION_WARN_FACTOR · (atol + rtol · max(1, max|q|))`` (rows in m or rad, plus
+      the unit-norm invariant of Euler parameters) drifted off the constraint manifold.
+    """
+    out: list[str] = []
+    n_t = len(t)
+    if energy is not None and getattr(system, "is_conservative", False) and n_t >= 2 and np.all(np.isfinite(energy)):
+        momenta = [np.asarray(system.M(t[i], Q[i]) @ V[i], float) for i in range(n_t)]
+        kinetic = np.array([0.5 * float(V[i] @ momenta[i]) for i in range(n_t)])
+        p_scale = max(float(np.sum(np.abs(momenta[i]))) + float(np.sum(np.abs(system.Q(t[i], Q[i], V[i]))))
+                      for i in range(n_t))
+        scale = float(np.max(kinetic)) if np.max(kinetic) > 0 else abs(float(energy[0]))
+        allowed = rtol * scale + atol * p_scale
+        drift = np.abs(energy - energy[0])
+        k = int(np.argmax(drift))
+        if allowed > 0 and drift[k] > ENERGY_WARN_FACTOR * allowed:
+            out.append(f"energy drift |E − E0| = {drift[k]:.3g} J at t = {t[k]:.6g} s is {drift[k] / allowed:.3g} × "
+                       f"what the tolerances allow, rtol × {scale:.3g} J (peak kinetic energy) + atol × {p_scale:.3g} "
+                       f"(|M v| + |Q|), for this conservative system (limit {ENERGY_WARN_FACTOR:g} ×); "
+                       "tighten the tolerance or the step")
+    if n_t and len(position_violation):
+        q_scale = max(1.0, float(np.max(np.abs(Q)))) if Q.size else 1.0
+        limit = VIOLATION_WARN_FACTOR * (atol + rtol * q_scale)
+        k = int(np.argmax(position_violation))
+        if position_violation[k] > limit:
+            out.append(f"position constraints violated by {position_violation[k]:.3g} at t = {t[k]:.6g} s (limit "
+                       f"{limit:.3g} = {VIOLATION_WARN_FACTOR:g} × (atol + rtol · {q_scale:.3g})); use a stabilised "
+                       "formulation (-projection, -baumgarte) or a tighter tolerance")
+    return out
 
 
 def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] = "rk45-projection", *,
@@ -171,6 +221,9 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
             for name, val in system.reactions(t, q, lam).items():
                 reactions.setdefault(name, []).append(val)
     reactions_arr = {n: np.array(v) for n, v in reactions.items() if len(v) == n_t}
+    if integ.status in FINISHED_STATUSES:
+        for text in result_checks(system, ts, Q, V, energy, np.maximum(pos_viol, inv_viol), rtol, atol):
+            integ.add_warning(text)
     meta = run_metadata(
         method=cls.name,
         system=system.name,
@@ -189,6 +242,7 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
         lam=L,
         status=integ.status,
         message=integ.message or "",
+        warnings=tuple(integ.warnings),
         counters=dict(integ.counters),
         meta=meta,
         coordinate_names=list(system.coordinate_names),

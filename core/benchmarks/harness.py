@@ -194,7 +194,7 @@ def _run_case(case: _Case) -> dict[str, Any]:
             row["message"] = f"{type(exc).__name__}: {exc}"
             return row
         walls.append(float(result.meta["wall_time_s"]))
-        if result.status != "finished" or sum(walls) >= case.max_repeat_time:
+        if not result.success or sum(walls) >= case.max_repeat_time:
             break
     assert result is not None
     row["wall time [s]"] = statistics.median(walls)
@@ -215,7 +215,7 @@ def _run_case(case: _Case) -> dict[str, Any]:
             E = np.asarray(result.energy, float)
             scale = prob.energy_scale if prob.energy_scale is not None else abs(E[0])
             row["energy drift [-]"] = float(np.max(np.abs(E - E[0])) / scale) if scale > 0 else math.nan
-    if result.status == "finished":
+    if result.success:
         try:
             err = prob.error(result, system=system, reference=case.reference)
         except Exception as exc:  # noqa: BLE001
@@ -382,6 +382,8 @@ def run_problem_set(problems: Sequence[str], grid: str, methods=None, repeats: i
     for prob, g, start, n in plan:
         df = _frame(prob, g, rows[start:start + n])
         if report is not None:
-            report(f"{prob.name}: {n} runs, {int((df['status'] != 'finished').sum())} failed")
+            n_failed = int((df["status"] == "failed").sum())
+            n_warned = int((df["status"] == "finished with warnings").sum())
+            report(f"{prob.name}: {n} runs, {n_failed} failed, {n_warned} finished with warnings")
         frames.append(df)
     return pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=COLUMNS)

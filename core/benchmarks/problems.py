@@ -204,7 +204,7 @@ class WorkPrecisionProblem:
         reference : optional
             The reference quantity (default: :meth:`reference`).
         """
-        if result.status != "finished" or abs(float(result.t[-1]) - self.t_end) > 1e-9 * max(1.0, self.t_end):
+        if not result.success or abs(float(result.t[-1]) - self.t_end) > 1e-9 * max(1.0, self.t_end):
             return math.nan
         system = self.build_system() if system is None else system
         ref = self.reference() if reference is None else reference

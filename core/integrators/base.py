@@ -2,8 +2,29 @@ r"""Step-based integrator objects and their registry (the driver is :func:`core.
 
 Every integrator follows the scipy ``OdeSolver`` pattern (scipy/integrate/_ivp/base.py):
 construct with the system, the time span and the initial state; call :meth:`Integrator.step`
-until :attr:`status` is ``"finished"`` or ``"failed"``; read :attr:`message`, the counters and
-:meth:`dense_output` for the last step.
+until :attr:`status` is ``"finished"``, ``"finished with warnings"`` or ``"failed"``; read
+:attr:`message`, :attr:`warnings`, the counters and :meth:`dense_output` for the last step.
+
+Error checks of fixed-step methods
+----------------------------------
+A fixed-step method has no error control, so after every step the base class estimates the
+local error from the step's own end data by the defect of the corrected trapezoidal rule
+(Euler–Maclaurin; Hairer, Nørsett & Wanner I, Sec. II.10 on defect-based estimates):
+
+.. math::
+
+    e_n = q_{n+1} - q_n - \tfrac{h}{2}(\dot q_n + \dot q_{n+1}) - \tfrac{h^2}{12}(\ddot q_n - \ddot q_{n+1}),
+    \qquad \varepsilon_n = \big\lVert e_n / (\mathrm{atol} + \mathrm{rtol}\,|q|) \big\rVert_{\mathrm{RMS}},
+
+with ``q̇ = Z(q) v`` and ``q̈ = Z(q) v̇ + Ż v`` from the index-1 accelerations.  The exact motion
+has ``e = O(h⁵)``; a numerical step whose positions and velocities disagree leaves its position
+error in ``e`` (for the Newmark family it is the Zienkiewicz–Xie estimate
+``(β − 1/6) h² (a_{n+1} − a_n)`` of the position error; for a method of order ≤ 3 it is the
+leading local error; for order 4 it over-estimates by one power of h).  Errors of an
+oscillating (conservative) motion add up along the run, so the **global error estimate** is
+``Σ ε_n`` in units of the tolerance: the run ends ``"finished with warnings"`` when it exceeds 1,
+naming the estimate, and ``"failed"`` at the first step whose estimate exceeds the state itself
+(``‖e‖∞ > max(‖q_n‖∞, ‖q_{n+1}‖∞)``: no correct digit left).
 
 Extension contract (for a new integrator class):
 
@@ -35,11 +56,16 @@ from numpy.typing import NDArray
 from ..assembly import check_initial_state
 from ..errors import RUN_FAILURES, InputError, NumericalFailure, UnknownOptionError
 from ..registry import Registry
+from ..results import FINISHED_STATUSES, STATUS_FAILED, STATUS_FINISHED, STATUS_WARNED
 from ..system import ConstrainedSystem
 
 Array = NDArray[np.float64]
 
-STATUS_RUNNING, STATUS_FINISHED, STATUS_FAILED = "running", "finished", "failed"
+STATUS_RUNNING = "running"
+
+#: A fixed-step run fails when one step's local error estimate exceeds the size of the state itself
+#: (not one correct digit left; see :meth:`Integrator._fixed_step_error_check`).
+NO_CORRECT_DIGIT = 1.0
 
 
 class IntegrationFailure(NumericalFailure):
@@ -65,8 +91,14 @@ class Integrator:
 
     Attributes
     ----------
-    status : {'running', 'finished', 'failed'}
+    status : {'running', 'finished', 'finished with warnings', 'failed'}
     message : str or None
+    warnings : list of str
+        What the checks found doubtful in a run that reached the end time (status
+        ``"finished with warnings"``); each is also appended to :attr:`message`.
+    error_estimate : float
+        Fixed-step methods: the global error estimate ``Σ ε_n`` in units of the tolerance
+        (see the module docstring); NaN for error-controlled methods.
     t, t_old : float
     q, v : ndarray
     lam : ndarray or None
@@ -82,6 +114,11 @@ class Integrator:
     #: Steps land on requested output times: :func:`simulate` calls :meth:`advance` with the next
     #: output time instead of :meth:`step` + dense output (compiled loops that take many steps per call).
     steps_to_output: bool = False
+
+    @property
+    def estimates_fixed_step_error(self) -> bool:
+        """True when the run has no error control, so the base class estimates it (module docstring)."""
+        return self.fixed_step and not getattr(self, "adaptive", False)
 
     def __init__(self, system: ConstrainedSystem, t_span, q0=None, v0=None, *, rtol: float = 1e-6,
                  atol: float = 1e-8, h: float | None = None, max_step: float = np.inf, **options):
@@ -117,6 +154,9 @@ class Integrator:
         self.options = options
         self.status = STATUS_RUNNING
         self.message: str | None = None
+        self.warnings: list[str] = []
+        self.error_estimate = 0.0 if self.estimates_fixed_step_error else np.nan
+        self._largest_local = (0.0, t0)  # largest ε_n and where
         self.counters = dict(n_steps=0, n_rejected=0, n_rhs=0, n_jac=0, n_factor=0, n_newton=0)
         unknown = set(options) - set(self.accepted_options())
         if unknown:
@@ -152,6 +192,9 @@ class Integrator:
             ok, msg = False, f"{type(exc).__name__}: {exc}"
         if ok and not (np.all(np.isfinite(self.q)) and np.all(np.isfinite(self.v))):
             ok, msg = False, "state became non-finite (NaN or Inf): the integration diverged"
+        if ok and self.estimates_fixed_step_error:
+            msg = self._fixed_step_error_check()
+            ok = msg is None
         if not ok:
             self.status = STATUS_FAILED
             self.message = f"{self.name} failed at t = {self.t_old:.6g} s: {msg}"
@@ -162,9 +205,67 @@ class Integrator:
             self.system.accept_step(self.t, self.q, self.v)
         self.counters["n_steps"] += 1
         if self.t >= self.t_bound - 1e-12 * max(1.0, abs(self.t_bound)):
-            self.t = self.t_bound
-            self.status = STATUS_FINISHED
-            self.message = "reached the end of the time span"
+            self._finish()
+        return None
+
+    def _finish(self) -> None:
+        """Mark the run as having reached the end time (with warnings when a check found any)."""
+        self.t = self.t_bound
+        if self.estimates_fixed_step_error and self.error_estimate > 1.0:
+            eps, where = self._largest_local
+            self.warnings.append(
+                f"fixed step h = {self.h:.3g} s: estimated global error {self.error_estimate:.3g} × the tolerance "
+                f"(rtol = {self.rtol:.3g}, atol = {self.atol:.3g}; sum of the local error estimates of "
+                f"{self.counters['n_steps']} steps, the largest {eps:.3g} at t = {where:.6g} s); use a smaller h")
+        self.status = STATUS_WARNED if self.warnings else STATUS_FINISHED
+        self.message = "; ".join(["reached the end of the time span"] + [f"warning: {w}" for w in self.warnings])
+
+    def add_warning(self, text: str) -> None:
+        """Record a doubt about a run; a finished run becomes ``"finished with warnings"``."""
+        self.warnings.append(text)
+        if self.status in FINISHED_STATUSES:
+            self.status = STATUS_WARNED
+            self.message = f"{self.message}; warning: {text}"
+
+    # --- error estimate of fixed-step methods ---------------------------------------------------
+    def _acceleration_at(self, t, q, v):
+        from ..dynamics import accelerations
+
+        a, _ = accelerations(self.system, t, q, v)
+        self.counters["n_rhs"] += 1
+        return a
+
+    def _qddot(self, q, v, a):
+        """``q̈ = Z(q) v̇ + Ż(q) v``; ``Ż v`` by a directional difference of ``qdot`` along ``q̇``."""
+        sys_ = self.system
+        qd = sys_.qdot(q, v)
+        out = sys_.qdot(q, a)
+        nrm = float(np.max(np.abs(qd), initial=0.0))
+        if nrm > 0:
+            eps = np.sqrt(np.finfo(float).eps) * max(1.0, float(np.max(np.abs(q), initial=0.0))) / nrm
+            out = out + (sys_.qdot(q + eps * qd, v) - sys_.qdot(q, v)) / eps
+        return out
+
+    def _fixed_step_error_check(self) -> str | None:
+        """Add this step's local error estimate ``ε_n`` to :attr:`error_estimate` (module docstring)."""
+        if self.a_old is None:
+            self.a_old = self._acceleration_at(self.t_old, self.q_old, self.v_old)
+        if self.a is None:
+            self.a = self._acceleration_at(self.t, self.q, self.v)
+        sys_ = self.system
+        h = self.t - self.t_old
+        q0, q1 = self.q_old, self.q
+        e = (q1 - q0 - 0.5 * h * (sys_.qdot(q0, self.v_old) + sys_.qdot(q1, self.v))
+             - h * h / 12.0 * (self._qddot(q0, self.v_old, self.a_old) - self._qddot(q1, self.v, self.a)))
+        w = self.atol + self.rtol * np.maximum(np.abs(q0), np.abs(q1))
+        eps = float(np.sqrt(np.mean((e / w) ** 2))) if e.size else 0.0
+        size = max(float(np.max(np.abs(q0), initial=0.0)), float(np.max(np.abs(q1), initial=0.0)), self.atol)
+        if not np.isfinite(eps) or float(np.max(np.abs(e), initial=0.0)) > NO_CORRECT_DIGIT * size:
+            return (f"local error estimate {float(np.max(np.abs(e), initial=0.0)):.3g} exceeds the size of the state "
+                    f"({size:.3g}) with the fixed step h = {h:.3g} s: no correct digit left; use a smaller h")
+        self.error_estimate += eps
+        if eps > self._largest_local[0]:
+            self._largest_local = (eps, self.t)
         return None
 
     def advance(self, t_target: float) -> str | None:

@@ -94,7 +94,7 @@ from ..compiled import dynamics as _d
 from ..compiled import layout as _l
 from ..compiled import protocol as _p
 from ..errors import InputError, NotCompilable
-from .base import STATUS_FAILED, STATUS_FINISHED, STATUS_RUNNING, Integrator, register
+from .base import STATUS_FAILED, STATUS_RUNNING, Integrator, register
 from .compiled_rk import (
     C_FACT,
     C_REJ,
@@ -970,9 +970,7 @@ class CompiledRadau(Integrator):
         self._sync()
         if code in (EXIT_REACHED, EXIT_MAX_STEPS):
             if self.t >= self.t_bound - 1e-12 * max(1.0, abs(self.t_bound)):
-                self.t = self.t_bound
-                self.status = STATUS_FINISHED
-                self.message = "reached the end of the time span"
+                self._finish()
             return None
         if code == EXIT_TOO_SMALL:
             why = (f"step size fell below 10 ulp(t) at t = {info[3]:.6g} s (the Newton iteration does not converge "

@@ -54,7 +54,7 @@ from ..compiled import dynamics as _d
 from ..compiled import layout as _l
 from ..compiled import protocol as _p
 from ..errors import InputError, NotCompilable
-from .base import STATUS_FAILED, STATUS_FINISHED, STATUS_RUNNING, Integrator, register
+from .base import STATUS_FAILED, STATUS_RUNNING, Integrator, register
 from .index1 import DEFAULT_BAUMGARTE
 
 _jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
@@ -469,14 +469,13 @@ class CompiledRK(Integrator):
             self.stiffness_detected_at = float(info[4])
         if code in (EXIT_REACHED, EXIT_MAX_STEPS):
             if self.t >= self.t_bound - 1e-12 * max(1.0, abs(self.t_bound)):
-                self.t = self.t_bound
-                self.status = STATUS_FINISHED
-                self.message = "reached the end of the time span"
                 if self.stiffness_detected_at is not None:
-                    self.message += (f"; warning: the problem became stiff at t = {self.stiffness_detected_at:.6g} s "
-                                     f"(h|λ| ≈ {info[5]:.3g} beyond the stability boundary {self._stiff_bound} on "
-                                     f"{STIFF_STEPS} consecutive steps): the step size is limited by stability and "
-                                     "the stiff components are not error-controlled; check with an implicit method")
+                    self.warnings.append(
+                        f"the problem became stiff at t = {self.stiffness_detected_at:.6g} s "
+                        f"(h|λ| ≈ {info[5]:.3g} beyond the stability boundary {self._stiff_bound} on "
+                        f"{STIFF_STEPS} consecutive steps): the step size is limited by stability and "
+                        "the stiff components are not error-controlled; check with an implicit method")
+                self._finish()
             return None
         if code == EXIT_TOO_SMALL:
             why = (f"step size fell below 10 ulp(t) at t = {info[3]:.6g} s (error test failing, e.g. non-finite "

@@ -137,7 +137,9 @@ def test_a02_short_simulation_conserves_energy_and_follows_pendulum_reference():
     scale = 81 * 9.81 * 1.0  # m g L of the whole mechanism [J]
     err, drift = [], []
     for h in (5e-3, 2.5e-3):
-        r = simulate(m, (0.0, 0.5), "generalized-alpha", h=h, t_eval=t, compute_multipliers=False)
+        # rtol: the accuracy asserted below (Newton still solves to 1e-8)
+        r = simulate(m, (0.0, 0.5), "generalized-alpha", h=h, t_eval=t, compute_multipliers=False, rtol=1e-4,
+                     atol=1e-6)
         assert r.status == "finished", r.message
         err.append(np.max(np.abs(r.q[:, 3 * k + 2] - phi_ref)))
         drift.append(np.max(np.abs(r.energy - r.energy[0])))

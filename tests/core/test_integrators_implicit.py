@@ -152,9 +152,10 @@ def _period(t, ang):
 
 
 @pytest.mark.parametrize("method,kw,tol_fn", [
-    # second-order method: relative period error ~ (ω0 h)²; 10× margin
-    ("generalized-alpha", dict(h=1e-3, rtol=1e-9, atol=1e-11), lambda w0: 10 * (w0 * 1e-3) ** 2),
-    ("hht", dict(h=1e-3, rtol=1e-9, atol=1e-11), lambda w0: 10 * (w0 * 1e-3) ** 2),
+    # second-order method: relative period error ~ (ω0 h)²; 10× margin. rtol states the accuracy
+    # the step gives (the fixed-step error estimate checks it); Newton solves to min(rtol, 1e-8)
+    ("generalized-alpha", dict(h=1e-3, rtol=1e-4, atol=1e-6), lambda w0: 10 * (w0 * 1e-3) ** 2),
+    ("hht", dict(h=1e-3, rtol=1e-4, atol=1e-6), lambda w0: 10 * (w0 * 1e-3) ** 2),
     # error-controlled: relative period error well below 100 rtol
     ("radau-ggl", dict(rtol=1e-8, atol=1e-10), lambda w0: 1e-6),
 ])
@@ -181,8 +182,10 @@ def test_generalized_alpha_second_order():
     hs = np.array([4e-3, 2e-3, 1e-3, 5e-4])
     errs = []
     for h in hs:
-        r = simulate(model, (0, t_end), "generalized-alpha", h=h, rtol=1e-11, atol=1e-13, n_output=2,
-                     compute_multipliers=False)
+        # rtol: the accuracy of the coarsest step; the Newton iteration solves to 1e-11 so that its
+        # error stays below the discretisation error of the finest
+        r = simulate(model, (0, t_end), "generalized-alpha", h=h, rtol=1e-3, atol=1e-5, newton_tol=1e-11,
+                     n_output=2, compute_multipliers=False)
         assert r.status == "finished", r.message
         errs.append(np.linalg.norm(tip_from_q(r.q[-1], N) - tip_ref))
     slope = np.polyfit(np.log(hs), np.log(errs), 1)[0]
@@ -222,10 +225,11 @@ def test_stiff_point_spring_chain_matches_revolute_chain():
     stiff = spring_chain_model(N, k)
     rigid = chain_model(N)
     t_eval = np.linspace(0, t_end, 51)
-    rs = simulate(stiff, (0, t_end), "generalized-alpha", h=h, rtol=1e-8, atol=1e-10, t_eval=t_eval,
-                  compute_multipliers=False)
+    # rtol: the accuracy h = 1e-3 gives on this chain (Newton solves to 1e-8 regardless)
+    acc = dict(rtol=1e-2, atol=1e-4, newton_tol=1e-8)
+    rs = simulate(stiff, (0, t_end), "generalized-alpha", h=h, t_eval=t_eval, compute_multipliers=False, **acc)
     assert rs.status == "finished", rs.message
-    rr = simulate(rigid, (0, t_end), "generalized-alpha", h=h, rtol=1e-8, atol=1e-10, t_eval=t_eval)
+    rr = simulate(rigid, (0, t_end), "generalized-alpha", h=h, t_eval=t_eval, **acc)
     assert rr.status == "finished", rr.message
     # penalty joints stretch by |λ|/k each: the tip deviation is O(N max|λ| / k)
     lam_max = np.nanmax(np.abs(rr.lam))
@@ -236,21 +240,24 @@ def test_stiff_point_spring_chain_matches_revolute_chain():
 @pytest.mark.parametrize("method", ["generalized-alpha", "hht"])
 def test_velocity_projection_holds_velocity_constraints(method):
     model = chain_model(3)
-    r0 = simulate(model, (0, 0.5), method, h=2e-3, n_output=11, compute_multipliers=False)
-    r1 = simulate(model, (0, 0.5), method, h=2e-3, n_output=11, compute_multipliers=False,
-                  velocity_projection=True)
+    acc = dict(rtol=1e-2, atol=1e-4, newton_tol=1e-8)  # the accuracy of h = 2e-3 on this chain
+    r0 = simulate(model, (0, 0.5), method, h=2e-3, n_output=11, compute_multipliers=False,
+                  velocity_projection=False, **acc)
+    r1 = simulate(model, (0, 0.5), method, h=2e-3, n_output=11, compute_multipliers=False, **acc)
     assert r0.status == r1.status == "finished"
     assert r1.velocity_violation[-1] < 1e-9
     assert r0.velocity_violation.max() > r1.velocity_violation[-1]
 
 
 def test_whip_chain_fails_or_is_right():
-    """N = 32 whip at h = 1e-2, fixed step: never 'finished' with a wrong answer."""
+    """N = 32 whip at h = 1e-2, fixed step: never 'finished' (without warning) with a wrong answer."""
     N = 32
     model = chain_model(N)
     r = simulate(model, (0, 1.0), "generalized-alpha", h=1e-2, adaptive=False, n_output=2,
-                 compute_multipliers=False)
-    if r.status == "finished":
+                 compute_multipliers=False, rtol=1e-2, atol=1e-4)
+    if r.status == "finished with warnings":
+        assert "estimated global error" in r.message or "energy drift" in r.message
+    elif r.status == "finished":
         ref = chain_reference(N, 1.0, rtol=1e-11)
         err = np.linalg.norm(tip_from_q(r.q[-1], N) - tip_from_angles(ref.y[:N, -1], N))
         assert err < 1e-2, err
@@ -264,7 +271,9 @@ def test_adaptive_generalized_alpha_recovers():
     model = chain_model(N)
     r = simulate(model, (0, 1.0), "generalized-alpha", h=1e-2, adaptive=True, rtol=1e-4, atol=1e-6,
                  n_output=2, compute_multipliers=False)
-    assert r.status == "finished", r.message
+    # ρ∞ = 0.9 damps the whip's fast modes: the energy check flags the dissipation (1.2 % of the
+    # peak kinetic energy), the tip is still right
+    assert r.status == "finished with warnings" and "energy drift" in r.message, r.message
     ref = chain_reference(N, 1.0, rtol=1e-11)
     err = np.linalg.norm(tip_from_q(r.q[-1], N) - tip_from_angles(ref.y[:N, -1], N))
     assert err < 1e-2, err

@@ -17,6 +17,7 @@ from core.integrators import METHODS, simulate
 from core.integrators.half_explicit import HEM3_TABLEAU, HEM4_TABLEAU
 from core.integrators.index1 import INDEX1_METHODS
 from core.model import ModelBuilder
+from core.results import FINISHED_STATUSES
 from core.system import ConstrainedSystem
 
 G = 9.81
@@ -79,15 +80,18 @@ def test_tableaux_satisfy_classical_order_conditions(order, tab):
     ("radau-projection", {}),
     ("bdf-baumgarte", {}),
     ("lsoda-projection", {}),
-    ("hem4", {"h": 5e-3}),
+    ("hem4", {"h": 5e-3, "rtol": 1e-8}),  # the accuracy h = 5e-3 gives (fixed-step error estimate 0.2)
 ])
 def test_compound_pendulum_period_matches_elliptic_integral(method, kw):
     theta0 = 0.5
     T = exact_period(theta0)
-    rtol = 1e-9
+    kw = dict(kw)
+    rtol = kw.pop("rtol", 1e-9)
     r = simulate(rod(theta0), (0.0, 1.1 * T), method, rtol=rtol, atol=1e-11, n_output=1001,
                  compute_multipliers=False, **kw)
-    assert r.status == "finished", r.message
+    # an adaptive method's global error is a few times rtol (the period tolerance below allows
+    # 1e3 rtol): the energy check (3 × rtol × peak kinetic energy) may flag the drift, nothing else
+    assert r.status == "finished" or all(w.startswith("energy drift") for w in r.warnings), r.message
     omega = r.v[:, 2]
     tz = zero_crossings(r.t, omega)  # ω = 0 at the turning points, every T/2
     assert len(tz) >= 2
@@ -96,7 +100,7 @@ def test_compound_pendulum_period_matches_elliptic_integral(method, kw):
     # is O(k dt³) (k = 3g/2L); integration error O(rtol) (adaptive) or O(h⁴) (hem4)
     dt = r.t[1] - r.t[0]
     k = 1.5 * G / L
-    tol = 10 * k * dt**3 + (1e3 * rtol * T if not kw else 20 * kw["h"] ** 4 * T)
+    tol = 10 * k * dt**3 + (1e3 * rtol * T if "h" not in kw else 20 * kw["h"] ** 4 * T)
     assert abs(period - T) < tol, (period, T)
     # the large-amplitude correction matters at this amplitude: the small-angle period is off
     T0 = 2 * np.pi * np.sqrt(2 * L / (3 * G))
@@ -128,7 +132,8 @@ def _step_end_violations(method, model, t_end, **kw):
         integ.step()
         pos.append(np.max(np.abs(model.Phi(integ.t, integ.q))))
         vel.append(np.max(np.abs(model.velocity_violation(integ.t, integ.q, integ.v))))
-    assert integ.status == "finished", integ.message
+    # the constraints are what is measured here; a fixed-step run may carry its error warning
+    assert integ.status in FINISHED_STATUSES, integ.message
     return np.array(pos), np.array(vel), integ
 
 
@@ -166,7 +171,8 @@ def test_half_explicit_convergence_order(method, order):
     err = []
     for h in hs:
         r = simulate(model, (0.0, 1.0), method, h=h, n_output=2)
-        assert r.status == "finished"
+        # the coarse steps carry the fixed-step error warning (their error exceeds rtol = 1e-6)
+        assert r.success, r.message
         err.append(abs(r.q[-1, 2] - ref.y[0, -1]) + abs(r.v[-1, 2] - ref.y[1, -1]))
         # velocity constraints hold at every step end by construction
         assert r.velocity_violation[-1] < 1e-12
@@ -230,11 +236,12 @@ def test_nan_force_ends_failed_with_time_and_keeps_output(method, kw):
     assert np.max(np.abs(np.sum(r.q**2, 1) - 1.0)) < 1e-4
 
 
-@pytest.mark.parametrize("method,kw", [("rk45-projection", {}), ("hem4", {"h": 5e-3})])
+@pytest.mark.parametrize("method,kw", [("rk45-projection", dict(rtol=1e-9, atol=1e-11)),
+                                       ("hem4", dict(h=5e-3, rtol=1e-7, atol=1e-9))])  # hem4: h = 5e-3 gives ~1e-8
 def test_spatial_rod_matches_planar(method, kw):
     theta0 = 1.0
-    r2 = simulate(rod(theta0, 2), (0.0, 2.0), method, rtol=1e-9, atol=1e-11, n_output=41, **kw)
-    r3 = simulate(rod(theta0, 3), (0.0, 2.0), method, rtol=1e-9, atol=1e-11, n_output=41, **kw)
+    r2 = simulate(rod(theta0, 2), (0.0, 2.0), method, n_output=41, **kw)
+    r3 = simulate(rod(theta0, 3), (0.0, 2.0), method, n_output=41, **kw)
     assert r2.status == r3.status == "finished", (r2.message, r3.message)
     assert np.max(np.abs(r3.q[:, :2] - r2.q[:, :2])) < 1e-7
     assert np.max(np.abs(r3.q[:, 2])) < 1e-9  # stays in the plane

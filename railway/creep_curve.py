@@ -146,6 +146,6 @@ def plot_creep_curve(df: pd.DataFrame, creepage: str | None = None, ax=None):
     ax[1].grid(True, alpha=0.3)
     ax[1].legend(fontsize="small")
     r = df.iloc[0]
-    fig.suptitle(f"N = {r['N [N]'] / 1e3:.1f} kN, a = {r['a [m]'] * 1e3:.2f} mm, "
+    fig.suptitle(f"creep curves — N = {r['N [N]'] / 1e3:.1f} kN, a = {r['a [m]'] * 1e3:.2f} mm, "
                  f"b = {r['b [m]'] * 1e3:.2f} mm, mu = {r['mu [-]']:.2f}", fontsize="medium")
     return fig

@@ -44,7 +44,13 @@ from .references import (
     stiff_chain_rhs,
     stiff_chain_tip_reference,
 )
-from .report import fastest_to_tolerance, work_precision_figure, write_work_precision
+from .report import (
+    REPORT_COLUMNS,
+    fastest_to_tolerance,
+    report_table,
+    work_precision_figure,
+    write_work_precision,
+)
 from .scenes import work_precision_scenes
 from .testset import AndrewsSqueezer, CarAxis
 
@@ -55,6 +61,7 @@ __all__ = [
     "GRID_NAMES",
     "PROBLEMS",
     "PROBLEM_SETS",
+    "REPORT_COLUMNS",
     "AndrewsSqueezer",
     "CarAxis",
     "Grid",
@@ -67,6 +74,7 @@ __all__ = [
     "pendulum_angle_exact",
     "problem_sets",
     "register_problem",
+    "report_table",
     "run_problem_set",
     "run_problems",
     "run_work_precision",

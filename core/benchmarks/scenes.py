@@ -13,7 +13,7 @@ from typing import Any
 
 from .harness import run_problem_set
 from .problems import PROBLEM_SETS, PROBLEMS
-from .report import fastest_to_tolerance, work_precision_figure
+from .report import fastest_to_tolerance, report_table, work_precision_figure
 
 __all__ = ["work_precision_scenes"]
 
@@ -46,8 +46,8 @@ def _work_precision_scene_run(ctx) -> Any:
     problems = PROBLEM_SETS[grid]
     jobs = _default_jobs()
     df = run_problem_set(problems, grid, repeats=1 if ctx.fast else 3, jobs=jobs)
-    tables = {f"wp_{p}": df[df["problem"] == p].reset_index(drop=True) for p in problems}
-    tables["wp_summary"] = fastest_to_tolerance(df)
+    tables = {f"wp_{p}": report_table(df[df["problem"] == p].reset_index(drop=True)) for p in problems}
+    tables["wp_summary"] = report_table(fastest_to_tolerance(df))
     figures = {f"wp_{p}": work_precision_figure(df, p) for p in problems}
     return SceneResult(tables=tables, figures=figures, notes=_scene_notes(problems, grid, jobs))
 

@@ -34,6 +34,8 @@ def _summary_row(label: str, res, **extra) -> dict:
         e = res.energy
         row["max |E − E0| [J]"] = float(np.max(np.abs(e - e[0])))
     row.update(extra)
+    # why a run is "finished with warnings" or "failed", in the table itself
+    row["remarks"] = "; ".join(res.warnings) if res.success else res.message
     return row
 
 
@@ -87,7 +89,8 @@ def _pendulum(ctx: SceneContext) -> SceneResult:
             "energy": plot.plot_energy(res, title=subject),
         },
         notes=(f"Point mass 1 kg on a massless 1 m link, released at θ0 = {theta0} rad from the vertical. "
-               f"Exact period {period_exact:.9f} s (complete elliptic integral)."),
+               f"Exact period {period_exact:.9f} s (complete elliptic integral); exact rod tension at the bottom "
+               f"{mass * G + 2.0 * mass * G * (1.0 - np.cos(theta0)):.9f} N (m g + m v²/l, v from energy)."),
     )
 
 

@@ -10,6 +10,11 @@
 * ``railway-two-point-contact`` -- two-point (tread + flange) contact of a conical wheel with a
   tight flange root on UIC60 1:40, with and without yaw (flange lead), checked by a brute-force
   gap scan; the quasi-static elastic case under a wheel load.
+
+Units of the written tables: the railway command line's (``mbsuite railway ...``) -- lengths in mm,
+contact angles in deg, wheelset yaw and roll in mrad, forces in kN, moments in kN m, moduli in GPa,
+creepages [-] and spin [1/m] -- in every table of a scene, so one quantity never appears in two
+units (:func:`_display_units` converts the SI tables of the library functions).
 """
 
 from __future__ import annotations
@@ -27,6 +32,34 @@ _REF_CREEP = (
     "References: Kalker (1990), Three-dimensional elastic bodies in rolling contact, Table E.3; "
     "Kalker (1982), VSD 11:1-13 (FASTSIM); Shen, Hedrick & Elkins (1983), VSD 12 Suppl.:79-83; "
     "Polach (2000), VSD 33 Suppl.:728-739; Polach (2005), Wear 258:992-1000.")
+
+
+#: SI unit -> (unit of the railway tables, factor): lengths mm, forces kN, moduli GPa.
+_DISPLAY = {"m": ("mm", 1e3), "um": ("mm", 1e-3), "N": ("kN", 1e-3), "N m": ("kN m", 1e-3),
+            "Pa": ("GPa", 1e-9)}
+#: Angles [rad] of the wheelset's attitude go to mrad (as ``--yaw-mrad``); other angles to deg.
+_ATTITUDE = ("yaw", "roll")
+#: Columns renamed on the way: the lateral shift of the wheelset has one name in every table.
+_RENAME = {"y": "lateral shift", "shift": "lateral shift"}
+
+
+def _display_units(df: pd.DataFrame) -> pd.DataFrame:
+    """A table of SI columns (``"name [unit]"``) in the units of the railway tables (module docstring)."""
+    out = {}
+    for col in df.columns:
+        name, unit = col, ""
+        if isinstance(col, str) and col.endswith("]") and " [" in col:
+            name, unit = col[:-1].rsplit(" [", 1)
+        name = _RENAME.get(name, name)
+        if unit == "rad":
+            to, factor = ("mrad", 1e3) if name.startswith(_ATTITUDE) else ("deg", 180.0 / np.pi)
+        else:
+            to, factor = _DISPLAY.get(unit, (unit, 1.0))
+        new = f"{name} [{to}]" if unit else name
+        out[new] = df[col] * factor if factor != 1.0 else df[col]
+    res = pd.DataFrame(out, index=df.index)
+    res.attrs = dict(df.attrs)
+    return res
 
 
 def _fig(nrows=1, ncols=1, size=(7, 4)):
@@ -47,47 +80,47 @@ def _run_contact_geometry(ctx):
     y_f, g_f = flange_contact_onset(df)
     picks = [0.001, 0.002, 0.003, 0.004, 0.005, 0.006, y_f]
     idx = [int(np.argmin(np.abs(df["y [m]"].to_numpy() - p))) for p in picks]
-    ex = df.iloc[idx]
-    excerpt = pd.DataFrame({
-        "lateral shift [mm]": ex["y [m]"].to_numpy() * 1e3,
-        "delta r [mm]": ex["delta_r [m]"].to_numpy() * 1e3,
-        "contact angle left [deg]": np.degrees(ex["gamma_L [rad]"].to_numpy()),
-        "contact angle right [deg]": np.degrees(ex["gamma_R [rad]"].to_numpy()),
-        "y_wheel left [mm]": ex["y_wheel_L [m]"].to_numpy() * 1e3,
-        "u_rail left [mm]": ex["u_rail_L [m]"].to_numpy() * 1e3,
-        "flange left": ex["flange_L"].to_numpy(),
-    })
-    summary = pd.DataFrame({
-        "quantity": ["flange-contact onset, lateral shift [mm]", "contact angle at onset [deg]"]
-        + [f"equivalent conicity at {a * 1e3:g} mm (EN 15302 wavelength) [-]"
-           for a in con["amplitude [m]"]]
-        + [f"equivalent conicity at {a * 1e3:g} mm (harmonic linearisation) [-]"
-           for a in con["amplitude [m]"]],
-        "value": [y_f * 1e3, np.degrees(g_f)] + list(con["conicity wavelength [-]"])
-        + list(con["conicity harmonic [-]"]),
-    })
-    ys = df["y [m]"] * 1e3
+    table = _display_units(df)
+    excerpt = table.iloc[idx][["lateral shift [mm]", "delta_r [mm]", "gamma_L [deg]", "gamma_R [deg]",
+                               "y_wheel_L [mm]", "u_rail_L [mm]", "flange_L"]].reset_index(drop=True)
+    amps = con["amplitude [m]"].to_numpy() * 1e3
+    summary = pd.DataFrame(
+        [("flange-contact onset, lateral shift", y_f * 1e3, "mm"),
+         ("contact angle at onset", np.degrees(g_f), "deg")]
+        + [(f"equivalent conicity at {a:g} mm (EN 15302 wavelength)", v, "-")
+           for a, v in zip(amps, con["conicity wavelength [-]"])]
+        + [(f"equivalent conicity at {a:g} mm (harmonic linearisation)", v, "-")
+           for a, v in zip(amps, con["conicity harmonic [-]"])],
+        columns=["quantity", "value", "unit"])
+    setting = (f"S1002 (r0 460 mm) / UIC60 1:40, gauge 1435 mm, flange-back 1360 mm, "
+               f"{n} shifts")
+    ys = table["lateral shift [mm]"]
     f1, ax = _fig()
     ax = ax[0, 0]
-    ax.plot(ys, df["delta_r [m]"] * 1e3, lw=1.2)
-    ax.axvline(y_f * 1e3, ls=":", c="k", lw=0.8)
+    ax.plot(ys, table["delta_r [mm]"], lw=1.2)
+    ax.axvline(y_f * 1e3, ls=":", c="k", lw=0.8, label=f"flange contact from {y_f * 1e3:.2f} mm")
     ax.set(xlabel="lateral shift y [mm]", ylabel=r"$\Delta r = r_L - r_R$ [mm]",
-           title="S1002 / UIC60 1:40, gauge 1435, flange-back 1360")
+           title=f"contact geometry — rolling-radius difference\n{setting}")
+    ax.title.set_fontsize(9)
+    ax.legend(fontsize=8)
     ax.grid(True, alpha=0.3)
     f2, ax = _fig()
     ax = ax[0, 0]
-    ax.plot(ys, np.degrees(df["gamma_L [rad]"]), lw=1.2, label="left wheel")
-    ax.plot(ys, np.degrees(df["gamma_R [rad]"]), lw=1.2, label="right wheel")
-    ax.set(xlabel="lateral shift y [mm]", ylabel="contact angle [deg]")
+    ax.plot(ys, table["gamma_L [deg]"], lw=1.2, label="left wheel")
+    ax.plot(ys, table["gamma_R [deg]"], lw=1.2, label="right wheel")
+    ax.set(xlabel="lateral shift y [mm]", ylabel="contact angle [deg]",
+           title=f"contact geometry — contact angles\n{setting}")
+    ax.title.set_fontsize(9)
     ax.legend()
     ax.grid(True, alpha=0.3)
     f3, ax = _fig(1, 2, size=(10, 4))
-    ax[0, 0].plot(ys, df["y_wheel_L [m]"] * 1e3, ".", ms=2, label="left")
-    ax[0, 0].plot(ys, df["y_wheel_R [m]"] * 1e3, ".", ms=2, label="right")
+    ax[0, 0].plot(ys, table["y_wheel_L [mm]"], ".", ms=2, label="left")
+    ax[0, 0].plot(ys, table["y_wheel_R [mm]"], ".", ms=2, label="right")
     ax[0, 0].set(xlabel="lateral shift y [mm]", ylabel="wheel contact y from taping line [mm]")
-    ax[0, 1].plot(ys, df["u_rail_L [m]"] * 1e3, ".", ms=2, label="left")
-    ax[0, 1].plot(ys, df["u_rail_R [m]"] * 1e3, ".", ms=2, label="right")
+    ax[0, 1].plot(ys, table["u_rail_L [mm]"], ".", ms=2, label="left")
+    ax[0, 1].plot(ys, table["u_rail_R [mm]"], ".", ms=2, label="right")
     ax[0, 1].set(xlabel="lateral shift y [mm]", ylabel="rail contact u from rail axis [mm]")
+    f3.suptitle(f"contact geometry — contact positions on wheel and rail\n{setting}", fontsize=10)
     for a in ax[0]:
         a.legend()
         a.grid(True, alpha=0.3)
@@ -99,9 +132,10 @@ def _run_contact_geometry(ctx):
         f"kinematic wavelength) {con['conicity wavelength [-]'].iloc[0]:.3f} / "
         f"{con['conicity wavelength [-]'].iloc[1]:.3f} / {con['conicity wavelength [-]'].iloc[2]:.3f}"
         f" at 2 / 3 / 4 mm. The contact point jumps across the S1002 tread (near-equal minima of "
-        f"the gap), hence the steps in the contact positions.\n\n" + _REF_GEOMETRY)
-    return dict(tables={"contact_geometry": df, "excerpt": excerpt, "summary": summary,
-                        "equivalent_conicity": con},
+        f"the gap), hence the steps in the contact positions. Tables in mm, deg (contact angles) "
+        f"and mrad (roll, yaw).\n\n" + _REF_GEOMETRY)
+    return dict(tables={"contact_geometry": table, "excerpt": excerpt, "summary": summary,
+                        "equivalent_conicity": _display_units(con)},
                 figures={"delta_r": f1, "contact_angle": f2, "contact_positions": f3}, notes=notes)
 
 
@@ -131,16 +165,23 @@ def _run_creep_curves(ctx):
         ex.append(row)
     excerpt = pd.DataFrame(ex)
     figs = {}
-    for stem, df, col, fcol, xl in (
-            ("Fx_vs_xi", xi_df, "xi [-]", "Fx [N]", r"longitudinal creepage $\xi$ [-]"),
-            ("Fy_vs_eta", eta_df, "eta [-]", "Fy [N]", r"lateral creepage $\eta$ [-]"),
-            ("Fy_vs_phi", phi_df, "phi [1/m]", "Fy [N]", r"spin $\varphi$ [1/m] ($\xi=\eta=0$)")):
+    mu_n = c["mu"] * c["normal_force"]
+    setting = (f"N = {c['normal_force'] / 1e3:g} kN, a = {c['a'] * 1e3:g} mm, b = {c['b'] * 1e3:g} mm, "
+               f"mu = {c['mu']:g}, G = {c['G'] / 1e9:g} GPa, nu = {c['nu']:g}; FASTSIM {fast_grid}x{fast_grid}")
+    for stem, df, col, fcol, xl, what in (
+            ("Fx_vs_xi", xi_df, "xi [-]", "Fx [N]", r"longitudinal creepage $\xi$ [-]",
+             r"$F_x(\xi)$, $\eta = \varphi = 0$"),
+            ("Fy_vs_eta", eta_df, "eta [-]", "Fy [N]", r"lateral creepage $\eta$ [-]",
+             r"$F_y(\eta)$, $\xi = \varphi = 0$"),
+            ("Fy_vs_phi", phi_df, "phi [1/m]", "Fy [N]", r"spin $\varphi$ [1/m] ($\xi=\eta=0$)",
+             r"$F_y(\varphi)$, $\xi = \eta = 0$")):
         fig, ax = _fig()
         ax = ax[0, 0]
         for name, sub in df.groupby("model", sort=False):
-            ax.plot(sub[col], -sub[fcol] / (c["mu"] * c["normal_force"]), label=name)
+            ax.plot(sub[col], -sub[fcol] / mu_n, label=name)
         ax.set(xlabel=xl, ylabel=f"-{fcol.split()[0]} / (mu N) [-]",
-               title="N = 100 kN, a = 6 mm, b = 4 mm, mu = 0.3, G = 80 GPa, nu = 0.28")
+               title=f"creep curves — {what}\n{setting}")
+        ax.title.set_fontsize(9)
         ax.legend(fontsize=8)
         ax.grid(True, alpha=0.3)
         figs[stem] = fig
@@ -148,10 +189,12 @@ def _run_creep_curves(ctx):
     ax = ax[0, 0]
     for (name, s0), (_, s1) in zip(eta_df.groupby("model", sort=False),
                                    eta_spin.groupby("model", sort=False)):
-        line, = ax.plot(s0["eta [-]"], -s0["Fy [N]"] / 30e3, label=f"{name}")
-        ax.plot(s1["eta [-]"], -s1["Fy [N]"] / 30e3, ls="--", c=line.get_color())
+        line, = ax.plot(s0["eta [-]"], -s0["Fy [N]"] / mu_n, label=f"{name}")
+        ax.plot(s1["eta [-]"], -s1["Fy [N]"] / mu_n, ls="--", c=line.get_color())
     ax.set(xlabel=r"lateral creepage $\eta$ [-]", ylabel="-Fy / (mu N) [-]",
-           title=r"spin effect: solid $\varphi = 0$, dashed $\varphi = 0.5$ 1/m")
+           title=r"creep curves — spin effect on $F_y(\eta)$: solid $\varphi = 0$, dashed "
+                 r"$\varphi = 0.5$ 1/m" + f"\n{setting}")
+    ax.title.set_fontsize(9)
     ax.legend(fontsize=8)
     ax.grid(True, alpha=0.3)
     figs["spin_effect"] = fig
@@ -163,9 +206,11 @@ def _run_creep_curves(ctx):
         "V = 20 m/s (the parameter set quoted in the project notes from Spiryagin, Polach & Cole "
         "2013 for a locomotive; not checked against Polach 2005, Table 2). Spin: Fy(phi) at "
         "xi = eta = 0 and Fy(eta) with phi = 0.5 1/m; Shen-Hedrick-Elkins saturates the linear spin "
-        "force to mu N, a known weakness of the heuristic.\n\n" + _REF_CREEP)
-    return dict(tables={"Fx_vs_xi": xi_df, "Fy_vs_eta": eta_df, "Fy_vs_phi": phi_df,
-                        "Fy_vs_eta_with_spin": eta_spin, "excerpt_Fx": excerpt},
+        "force to mu N, a known weakness of the heuristic. Tables in kN (forces, load), kN m (spin "
+        "moment), mm (semi-axes) and GPa (G).\n\n" + _REF_CREEP)
+    return dict(tables={"Fx_vs_xi": _display_units(xi_df), "Fy_vs_eta": _display_units(eta_df),
+                        "Fy_vs_phi": _display_units(phi_df),
+                        "Fy_vs_eta_with_spin": _display_units(eta_spin), "excerpt_Fx": excerpt},
                 figures=figs, notes=notes)
 
 
@@ -189,7 +234,7 @@ def _run_two_point(ctx):
         for _, r in df.iterrows():
             rows.append({
                 "yaw [mrad]": psi * 1e3, "contact": r["contact"],
-                "lateral shift [mm]": r["shift [m]"] * 1e3, "gap [um]": r["gap [m]"] * 1e6,
+                "lateral shift [mm]": r["shift [m]"] * 1e3, "gap [mm]": r["gap [m]"] * 1e3,
                 "contact angle [deg]": np.degrees(r["contact angle [rad]"]),
                 "y_wheel [mm]": r["y_wheel [m]"] * 1e3, "u_rail [mm]": r["u_rail [m]"] * 1e3,
                 "rolling radius [mm]": r["rolling radius [m]"] * 1e3,
@@ -199,24 +244,31 @@ def _run_two_point(ctx):
             })
         for _, m in mins.iterrows():
             checks.append({"yaw [mrad]": psi * 1e3, "brute-force minimum y_wheel [mm]":
-                           m["y_wheel [m]"] * 1e3, "vertical gap [um]": m["gap [m]"] * 1e6,
+                           m["y_wheel [m]"] * 1e3, "vertical gap [mm]": m["gap [m]"] * 1e3,
                            "lead [mm]": m["lead [m]"] * 1e3})
         checks.append({"yaw [mrad]": psi * 1e3, "brute-force minimum y_wheel [mm]": np.nan,
-                       "vertical gap [um]": scan["gap [m]"].min() * 1e6, "lead [mm]": np.nan})
+                       "vertical gap [mm]": scan["gap [m]"].min() * 1e3, "lead [mm]": np.nan})
     table = pd.DataFrame(rows)
     check = pd.DataFrame(checks)
     # quasi-static elastic contact under a wheel load: both contacts carry load past the onset
     y0 = table["lateral shift [mm]"].iloc[0] * 1e-3
     shifts = y0 + np.array([-0.5, -0.05, 0.0, 0.05, 0.1, 0.15, 0.2, 0.3]) * 1e-3
     qs = quasi_static_contact(shifts, 100e3, wheel=wheel)
+    setting = f"{wheel.name} / UIC60 1:40, gauge 1435 mm, flange-back 1360 mm"
     f1, ax = _fig()
     ax = ax[0, 0]
+    floor_mm = 1e-6  # the vertical gap at the contacts is zero to round-off (~1e-12 mm): floored
     for psi, scan in scans.items():
-        ax.semilogy(scan["y_wheel [m]"] * 1e3, np.maximum(scan["gap [m]"], 1e-9) * 1e3,
-                    lw=0.8, label=f"yaw {psi * 1e3:g} mrad")
+        # gaps below the floor (zero or negative to round-off at the contacts) are drawn below the
+        # visible range, so the line runs off the bottom edge there instead of breaking
+        ax.semilogy(scan["y_wheel [m]"] * 1e3, np.maximum(scan["gap [m]"] * 1e3, 1e-3 * floor_mm), lw=0.8,
+                    label=f"yaw {psi * 1e3:g} mrad")
     ax.set(xlabel="wheel profile coordinate y [mm] (flange < 0)",
-           ylabel="min over theta of vertical gap [mm] (floored at 1e-6 mm)",
-           title="brute-force gap at the rigid two-point configuration", ylim=(1e-6, 30))
+           ylabel="min over theta of vertical gap [mm]",
+           title=(f"two-point contact — brute-force gap scan at the rigid two-point configuration\n"
+                  f"{setting}; y-range floored at {floor_mm:g} mm (zero gap at the contacts)"),
+           ylim=(floor_mm, 30))
+    ax.title.set_fontsize(9)
     ax.legend()
     ax.grid(True, alpha=0.3)
     f2, ax = _fig(size=(7, 5))
@@ -233,11 +285,12 @@ def _run_two_point(ctx):
         "gap scan over (theta, y), independent of the Newton search: two local minima with zero "
         "gap, no penetration (last row per yaw: global minimum). quasi_static: elastic Hertz "
         "contact under 100 kN vertical load per wheel (yaw 0): the flange takes load from the "
-        "onset on, with both contacts loaded.\n\n"
+        "onset on, with both contacts loaded. Tables in mm, deg (contact angles), mrad (yaw, roll) "
+        "and kN.\n\n"
         "References: Pombo, Ambrosio & Silva (2007), VSD 45:165-189; Shabana, Zaazaa & "
         "Sugiyama (2008), Railroad Vehicle Dynamics, ch. 5; Johnson (1985), Contact Mechanics, "
         "ch. 4.")
-    return dict(tables={"two_point": table, "brute_force_check": check, "quasi_static": qs},
+    return dict(tables={"two_point": table, "brute_force_check": check, "quasi_static": _display_units(qs)},
                 figures={"gap_scan": f1, "cross_section": f2}, notes=notes)
 
 
@@ -262,7 +315,9 @@ def _plot_cross_section(ax, wheel, table):
         ax.plot((shift + yc + L) * 1e3, -wheel.evaluate(yc)[0] * 1e3, "o", c="C3")
     ax.set(xlabel="lateral position from track centre [mm]", ylabel="height [mm]",
            xlim=(680, 800), ylim=(-35, 10), aspect="equal",
-           title="rigid two-point contact (dots), yaw 0")
+           title=(f"two-point contact — cross-section at the rigid onset (contacts: dots), yaw 0\n"
+                  f"{wheel.name} / UIC60 1:40, lateral shift {shift * 1e3:.2f} mm"))
+    ax.title.set_fontsize(9)
     ax.legend(fontsize=8)
     ax.grid(True, alpha=0.3)
 

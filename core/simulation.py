@@ -29,11 +29,17 @@ import numpy as np
 
 from .dynamics import accelerations
 from .errors import RUN_FAILURES, InputError
-from .integrators.base import FINISHED_STATUSES, STATUS_FAILED, STATUS_RUNNING, Integrator, get_method
+from .integrators.base import (
+    FINISHED_STATUSES,
+    STATUS_FAILED,
+    STATUS_RUNNING,
+    Integrator,
+    get_method,
+)
 from .results import SimulationResult, run_metadata
 from .system import ConstrainedSystem
 
-__all__ = ["simulate", "result_checks", "ENERGY_WARN_FACTOR", "VIOLATION_WARN_FACTOR"]
+__all__ = ["ENERGY_WARN_FACTOR", "VIOLATION_WARN_FACTOR", "result_checks", "simulate"]
 
 #: A conservative run warns when ``max|E − E0| > ENERGY_WARN_FACTOR · (rtol · E_scale + atol · p_scale)``
 #: (see :func:`result_checks`).  On the pendulum study of the tests (every adaptive method,

@@ -276,6 +276,8 @@ class GeneralizedAlpha(Integrator):
         self.rho_inf = float(o.get("rho_inf", 0.9))
         self.alpha_m, self.alpha_f, self.beta, self.gamma = alpha_parameters(self.rho_inf, self.variant)
         self.adaptive = bool(o.get("adaptive", False))
+        if self.adaptive:
+            self.error_estimate = np.nan  # error-controlled: no fixed-step estimate (base class)
         # Newton tolerance (relative; absolute = 1e-2 × relative × unit scale). With a fixed step the
         # discretisation error is set by h, so the nonlinear solve must be well below it: tying it to
         # the default rtol = 1e-6 made the scheme look first-order; 1e-8 restores order 2 (1e-9 and

@@ -25,6 +25,7 @@ SI units throughout (m, rad); mm only in profile files and CLI output.
 from .contact_geometry import (
     conicity_table,
     contact_geometry_table,
+    contact_transitions,
     equivalent_conicity,
     flange_contact_onset,
     rigid_contact,
@@ -32,7 +33,7 @@ from .contact_geometry import (
 from .contact_search import ContactResult, ContactSearch, wheelset_pose
 from .forces import ContactForces
 from .profiles import RailProfile, WheelProfile, read_profile_file, s1002_exact, uic60_exact
-from .quasi_static import quasi_static_contact
+from .quasi_static import quasi_static_contact, quasi_static_summary
 from .surfaces import RailSurface, WheelSurface
 from .track import (
     Curve,
@@ -62,10 +63,12 @@ __all__ = [
     "WheelSurface",
     "conicity_table",
     "contact_geometry_table",
+    "contact_transitions",
     "equivalent_conicity",
     "flange_contact_onset",
     "parse_inclination",
     "quasi_static_contact",
+    "quasi_static_summary",
     "read_profile_file",
     "rigid_contact",
     "s1002_exact",

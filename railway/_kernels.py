@@ -355,6 +355,10 @@ def _define_scan():
                 out[rank, p, 1] = yg[p, jj] + tj * (yg[p, jj + 1] - yg[p, jj])
                 out[rank, p, 2] = s0[p] + xi[jj] + tj * (xi[jj + 1] - xi[jj])
                 out[rank, p, 3] = ug[jj] + tj * (ug[jj + 1] - ug[jj])
+                # sign change found, and the bracket one grid interval either side
+                out[rank, p, 4] = 1.0 if np.isfinite(gmid[j]) else 0.0
+                out[rank, p, 5] = yg[p, max(jj - 1, 0)]
+                out[rank, p, 6] = yg[p, min(jj + 2, G - 1)]
 
     return scan
 

@@ -84,7 +84,7 @@ def run_creep_curve(args: argparse.Namespace) -> int:
     from core.plot import save_figure
     from core.results import markdown_table, write_table
 
-    from .creep_curve import creep_curve, plot_creep_curve
+    from .creep_curve import SEMI_AXIS_RANGE, creep_curve, plot_creep_curve
     from .forces import wheel_rail_curvatures
 
     parser = getattr(args, "_creep_parser", None)
@@ -100,9 +100,18 @@ def run_creep_curve(args: argparse.Namespace) -> int:
         G = args.G_GPa * 1e9 if args.G_GPa is not None else None
         kw = dict(normal_force=N, E=E, G=G, nu=args.nu, mu=args.mu,
                   xi=args.xi, eta=args.eta, phi=args.phi)
+        if not (np.isfinite(args.load_kN) and args.load_kN > 0):
+            raise ValueError(f"--load-kN {args.load_kN!r}: the normal load must be positive (kN)")
         if (args.a_mm is None) != (args.b_mm is None):
             raise ValueError("give both --a-mm and --b-mm, or neither")
         if args.a_mm is not None:
+            for opt, v in (("--a-mm", args.a_mm), ("--b-mm", args.b_mm)):
+                lo, hi = SEMI_AXIS_RANGE[0] * 1e3, SEMI_AXIS_RANGE[1] * 1e3
+                if not (np.isfinite(v) and lo <= v <= hi):
+                    raise ValueError(f"{opt} {v!r}: the semi-axis is given in millimetres and must "
+                                     f"lie in [{lo:g}, {hi:g}] mm (e.g. 6)"
+                                     + (" -- it looks like metres" if np.isfinite(v) and 0 < v < lo
+                                        else ""))
             kw.update(a=args.a_mm * 1e-3, b=args.b_mm * 1e-3)
         else:
             A, B = wheel_rail_curvatures(args.wheel_radius_mm * 1e-3, args.wheel_lateral_radius_mm * 1e-3,

@@ -24,13 +24,30 @@ Solution strategy
   |W h|^2 is retried from the last accepted point with a quarter of its length.  Steps are
   limited and the parameters kept inside their zones.
 * The tread gap of S1002 on UIC60 1:40 has near-equal local minima, so the contact point jumps
-  across the tread.  A coarse scan of each zone in the cross-section (lowest point of each wheel
+  across the tread.  A coarse scan of each zone in the cross-section (grid uniform in the
+  profile's arc length over the whole zone, overlap included; lowest point of each wheel
   circle, rail point of the same tangent angle, sign changes of the fourth condition) gives the
-  two best stationary points as seeds; Newton runs from both (and from the warm start) side by
-  side and the lowest valid gap wins.  On a trajectory (``warm=True``) the warm start is
+  ``n_seeds`` best stationary points as seeds; Newton runs from them (and from the warm start)
+  side by side and the lowest valid gap wins.  On a trajectory (``warm=True``) the warm start is
   extrapolated linearly from the last two solutions, only candidates that had a contact are
   refined, and the global re-seeding runs every ``reseed_every`` calls and whenever a contact is
   lost.
+* Where Newton does not solve a scan seed (a stationary point lies near, by a sign change of
+  the fourth condition), the seed is refined by a derivative-free minimisation instead
+  (:meth:`ContactSearch._robust`): for a fixed wheel profile coordinate y the other three
+  conditions (h1, h3, h4) are solved for (theta, s, u) -- a well-conditioned 3x3 Newton, the
+  wheel point's projection on the rail -- which gives the gap psi(y) of that profile line, and
+  by the envelope theorem dpsi/dy = n . t_y = h2::
+
+      psi(y) = d . n  at  h1 = h3 = h4 = 0,        dpsi/dy = h2
+
+  so the four-condition solutions are the stationary points of psi and the contact is its
+  minimum.  psi is sampled densely in the seed's bracket and its minimum refined by Newton or,
+  where that fails, golden-section search.  This finds the contact where Newton's 4x4 Jacobian
+  is singular or jumps: the S1002 R13 flange root conformal with the UIC60 R13 gauge corner,
+  the root/flank joint with its slope step of ~1e-5 (where the rigid contact sits over a band
+  of shifts at the flange onset), and the ripples of splines through sampled, rounded profile
+  points (a measured profile exported at 0.25 or 0.5 mm).
 * A Newton step below ``tol_linear`` is applied without a further pass; the outputs are then
   linearised about the evaluated point (error O(step^2)).
 * With numba installed the same iteration, and the seed scan, run in compiled kernels
@@ -41,6 +58,8 @@ References
 Pombo, J., Ambrosio, J. and Silva, M. (2007). A new wheel-rail contact model for railway
 dynamics. Vehicle System Dynamics 45(2):165-189 (contact detection between the parametric
 wheel and rail surfaces; equation numbers were not checked against the paper here).
+Kiefer, J. (1953). Sequential minimax search for a maximum. Proc. Amer. Math. Soc.
+4(3):502-506 (golden-section search).
 """
 
 from __future__ import annotations
@@ -50,6 +69,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from core.curves import concatenate
+from core.errors import InputError
 
 from .profiles import WheelProfile
 from .track import RailMounting, Track
@@ -77,6 +97,16 @@ def _rot_z(a):
     return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
 
 
+def _arc_grid(profile, lo, hi, n):
+    """n points of [lo, hi] (m) uniform in the arc length of the curve y -> (y, F(y))."""
+    yd = np.linspace(lo, hi, 20 * n + 1)
+    ds = np.sqrt(1.0 + profile.poly(yd)[1] ** 2)
+    arc = np.concatenate([[0.0], np.cumsum(0.5 * (ds[1:] + ds[:-1]) * np.diff(yd))])
+    y = np.interp(np.linspace(0.0, arc[-1], n), arc, yd)
+    y[0], y[-1] = lo, hi
+    return y
+
+
 def wheelset_pose(track: Track, s, lateral=0.0, height=0.0, roll=0.0, yaw=0.0):
     """Wheelset centre position and orientation relative to the track frame.
 
@@ -100,7 +130,7 @@ def wheelset_pose(track: Track, s, lateral=0.0, height=0.0, roll=0.0, yaw=0.0):
     for name, v in (("s", s), ("lateral", lateral), ("height", height), ("roll", roll), ("yaw", yaw)):
         bad = ~np.isfinite(v)
         if np.any(bad):
-            raise ValueError(f"wheelset pose: {name}[{int(np.argmax(bad))}] = {v[bad][0]!r} is not finite")
+            raise InputError(f"wheelset pose: {name}[{int(np.argmax(bad))}] = {v[bad][0]!r} is not finite")
     fr = track.evaluate(s)
     loc = np.stack([np.zeros_like(s), lateral, height], axis=1)
     r = fr.position + np.einsum("nij,nj->ni", fr.R, loc)
@@ -235,7 +265,7 @@ class ContactSearch:
     reseed_every : int
         On trajectories, run the global tread scan every this many calls (1 = always).
     n_scan : int
-        Grid points of the tread scan.
+        Grid points of the seed scan per zone (uniform in the profile's arc length).
     zone_overlap : float
         Overlap of the tread and flange zones (m) so that a contact at the split is found.
     fd_step : float
@@ -243,6 +273,15 @@ class ContactSearch:
     jacobian : {"analytic", "fd"}
         Newton Jacobian: analytic (default, see :meth:`_residual_jac`) or forward differences
         (5 P residual evaluations stacked in one vectorised pass).
+    n_seeds : int
+        Stationary points of the scan refined side by side at a re-seeding (the best by the
+        scan's estimate of the gap; 2 by default, more where near-equal minima crowd, e.g. a
+        contact-geometry table).
+    extrapolate : bool
+        Predict the warm start of a trajectory by linear extrapolation of the last two
+        solutions (default); False starts from the last solution (for iterations that are not
+        a trajectory, e.g. the Newton steps of the rigid contact, where extrapolation across
+        a contact jump throws the start far off).
     flange_rail_u_max : float
         The flange candidate searches the rail only on the gauge side, u <= this value (m);
         otherwise the flange tip would pair with the rail crown (parallel normals, but the tip
@@ -256,7 +295,8 @@ class ContactSearch:
     def __init__(self, track, wheel=None, rails=None, n_wheelsets=1, flange_back_spacing=1.360,
                  tol=1e-8, max_iter=15, reseed_every=10, n_scan=64, zone_overlap=1e-3,
                  fd_step=1e-7, flange_rail_u_max=-0.020, max_penetration=0.005,
-                 jacobian="analytic", tol_linear=1e-6, compiled="auto"):
+                 jacobian="analytic", tol_linear=1e-6, compiled="auto", extrapolate=True,
+                 n_seeds=2):
         self.track = track
         self.wheel = wheel if wheel is not None else WheelProfile.s1002()
         if rails is None:
@@ -265,9 +305,12 @@ class ContactSearch:
             rails = (rails, rails)
         self.rails = tuple(rails)
         if not (isinstance(n_wheelsets, (int, np.integer)) and n_wheelsets >= 1):
-            raise ValueError(f"n_wheelsets = {n_wheelsets!r} must be a positive integer")
-        if not (np.isfinite(flange_back_spacing) and 1.0 < flange_back_spacing < 2.0):
-            raise ValueError(f"flange-back spacing {flange_back_spacing!r} m is not plausible")
+            raise InputError(f"n_wheelsets = {n_wheelsets!r} must be a positive integer")
+        if not (np.isfinite(flange_back_spacing) and 0.25 <= flange_back_spacing <= 2.0):
+            raise InputError(
+                f"flange-back spacing {flange_back_spacing!r} m is implausible (expected 0.25 to "
+                "2.0 m, e.g. 1.360); it is in metres"
+                + (" -- was it given in millimetres?" if flange_back_spacing > 2.0 else ""))
         self.n_wheelsets = int(n_wheelsets)
         self.flange_back_spacing = float(flange_back_spacing)
         self.L = 0.5 * self.flange_back_spacing - self.wheel.y_back
@@ -277,13 +320,17 @@ class ContactSearch:
         self.max_penetration = float(max_penetration)
         self.max_iter_reseed = 8  # re-seeding with a warm start: seeds beyond reach are dropped
         if jacobian not in ("analytic", "fd"):
-            raise ValueError(f"jacobian must be 'analytic' or 'fd', got {jacobian!r}")
+            raise InputError(f"jacobian must be 'analytic' or 'fd', got {jacobian!r}")
         self.jacobian = jacobian
         self.tol_linear = float(tol_linear)
+        self.extrapolate = bool(extrapolate)
+        if not (isinstance(n_seeds, (int, np.integer)) and n_seeds >= 1):
+            raise InputError(f"n_seeds = {n_seeds!r} must be a positive integer")
+        self.n_seeds = int(n_seeds)
         self._maxstep = np.array([0.02, 0.001, 0.01, 0.001])
         self._wts = np.array([1.0, 1.0, 1e3, 1e3])
         if compiled not in ("auto", True, False):
-            raise ValueError(f"compiled must be 'auto', True or False, got {compiled!r}")
+            raise InputError(f"compiled must be 'auto', True or False, got {compiled!r}")
         self._kernel = None
         self._scan_kernel = None
         if compiled:
@@ -312,9 +359,12 @@ class ContactSearch:
                           ca=np.where(sig > 0, mL.ca, mR.ca), sa=np.where(sig > 0, mL.sa, mR.sa))
         # scan grids of the tread and flange zones, and the rail tangent-angle tables
         G = self.n_scan
-        self._scan = {}
-        yz = np.stack([np.linspace(w.y_split, w.x_max, G),
-                       np.linspace(w.y_flange_min, w.y_split, G)])
+        if G < 8:
+            raise InputError(f"n_scan = {n_scan!r}: the seed scan needs at least 8 grid points")
+        # scan grids of the whole zones (overlap included), uniform in the profile's arc length
+        # so that the steep flank and the tight flange root get as many points per mm of
+        # profile as the flat tread
+        yz = np.stack([_arc_grid(w, ylo[0], yhi[0], G), _arc_grid(w, ylo[1], yhi[1], G)])
         Fz, F1z, _ = w.poly(yz)
         self._scan = dict(y=yz, r=w.r0 + Fz, F1=F1z)
         self._rail_tab = []
@@ -597,10 +647,15 @@ class ContactSearch:
         info["Rl"] = info["Rl"] + du * info["tu"]
         return info
 
-    def _seed_scan(self, pc, r_ws, A, s_ws, second=False):
+    def _seed_scan(self, pc, r_ws, A, s_ws, second=False, brackets=False, ranks=None):
         """Seeds (P, 4) from a coarse scan of each zone in the track cross-section.
 
-        With ``second=True`` a list [best, second best] is returned.
+        With ``second=True`` a list [best, second best] is returned, with ``ranks=k`` a list of
+        the k best (``second`` is ``ranks=2``).  With ``brackets=True``
+        each seed array has three more columns: 1.0 where the seed is a sign change of the
+        fourth condition (a stationary point lies near) else 0.0, and the profile coordinates
+        (m) of the grid points one interval either side of it, a bracket of that stationary
+        point for :meth:`_robust`.
 
         For grid points y_i of the zone, the lowest point of the wheel circle (towards the rail)
         and its profile tangent angle beta_i in the cross-section are computed; the rail point
@@ -623,15 +678,19 @@ class ContactSearch:
         tan, lat, up = fr_R[:, :, 0], fr_R[:, :, 1], fr_R[:, :, 2]
         sig = pc["sig"]
         yg, rg, F1g = (self._scan[k][pc["cand"]] for k in ("y", "r", "F1"))  # (P, G)
+        n_rank = int(ranks) if ranks else (2 if second else 1)
+        listed = bool(ranks) or second
         if self._scan_kernel is not None:  # the same scan, compiled (railway._kernels)
             dl = np.einsum("pkj,pk->pj", A[ws], -d)
             theta = np.arctan2(dl[:, 0], -dl[:, 2])
             (b0, u0, Y0, Z0), (b1, u1, Y1, Z1) = self._rail_tab
-            out = np.empty((2 if second else 1, P, 4))
+            out = np.empty((n_rank, P, 7))
             self._scan_kernel(np.ascontiguousarray(r_ws[ws]), ax, d, fr_pos, tan, lat, up, sig,
                               self.L, yg, rg, F1g, sig > 0, b0, u0, Y0, Z0, b1, u1, Y1, Z1,
                               pc["ulo"], pc["uhi"], theta, s_ws[ws], out.shape[0], out)
-            return list(out) if second else out[0]
+            if not brackets:
+                out = out[:, :, :4]
+            return list(out) if listed else out[0]
         ctr = r_ws[ws][:, None, :] + (sig[:, None] * (yg + self.L))[:, :, None] * ax[:, None, :]
         pts = ctr - rg[:, :, None] * d[:, None, :]
         rel = pts - fr_pos[:, None, :]
@@ -663,8 +722,9 @@ class ContactSearch:
         dl = np.einsum("pkj,pk->pj", A[ws], -d)
         theta = np.arctan2(dl[:, 0], -dl[:, 2])
         seeds = []
-        for rank in range(2 if second else 1):
-            if rank:  # the second-best stationary point (near-equal minima of the tread gap)
+        j = np.zeros(P, dtype=int)
+        for rank in range(n_rank):
+            if rank:  # the next-best stationary point (near-equal minima of the tread gap)
                 gmid = gmid.copy()
                 gmid[ii, j] = np.inf
             j = np.argmin(gmid, axis=1)
@@ -672,11 +732,16 @@ class ContactSearch:
             jj = np.where(has, j, np.minimum(j0, yg.shape[1] - 2))
             tj = np.where(has, t[ii, j], np.where(j0 == yg.shape[1] - 1, 1.0, 0.0))
 
-            def lerp(a):
+            def lerp(a, jj=jj, tj=tj):
                 return a[ii, jj] + tj * (a[ii, jj + 1] - a[ii, jj])
 
-            seeds.append(np.stack([theta, lerp(yg), s_ws[ws] + lerp(xi), lerp(ug)], axis=1))
-        return seeds if second else seeds[0]
+            cols = [theta, lerp(yg), s_ws[ws] + lerp(xi), lerp(ug)]
+            if brackets:
+                G = yg.shape[1]
+                cols += [has.astype(float), yg[ii, np.maximum(jj - 1, 0)],
+                         yg[ii, np.minimum(jj + 2, G - 1)]]
+            seeds.append(np.stack(cols, axis=1))
+        return seeds if listed else seeds[0]
 
     def _outputs(self, x, pc, info):
         """(gap (P,), S (P, 11), V (P, 3, 3)) from the numpy Newton's intermediate arrays."""
@@ -734,7 +799,7 @@ class ContactSearch:
             bad = ~np.isfinite(arr)
             if np.any(bad):
                 idx = np.unravel_index(int(np.argmax(bad)), arr.shape)
-                raise ValueError(f"contact search: {name}{list(map(int, idx))} = {float(arr[idx])!r} is not finite")
+                raise InputError(f"contact search: {name}{list(map(int, idx))} = {float(arr[idx])!r} is not finite")
         return r_ws, A, s_ws
 
     # ------------------------------------------------------------------------------------
@@ -776,7 +841,7 @@ class ContactSearch:
             # predictor: linear extrapolation of the last two solutions (theta, y, u); the rail
             # arc length moves with the wheelset
             x0 = self._x.copy()
-            xp = self._x_prev
+            xp = self._x_prev if self.extrapolate else None
             if xp is not None and xp.shape == x0.shape:
                 ext = 2.0 * x0 - xp
                 ok = np.isfinite(ext)
@@ -826,11 +891,13 @@ class ContactSearch:
             return res
         # re-seeding: the two best stationary points of the scan (and the warm start), refined
         # side by side; the lowest valid gap wins
-        seeds = self._seed_scan(pc, r_ws, A, s_ws, second=True)
+        scan_out = self._seed_scan(pc, r_ws, A, s_ws, brackets=True, ranks=self.n_seeds)
+        seeds = [q[:, :4] for q in scan_out]
         if have_warm:
             seeds.insert(0, x0)
         return self._multistart(np.concatenate(seeds), pc, rP, AP, store, 0,
-                                max_iter=self.max_iter_reseed if have_warm else None)
+                                max_iter=self.max_iter_reseed if have_warm else None,
+                                scan_out=scan_out)
 
     def _valid_gap(self, x, conv, info, pc):
         """Validity (converged inside the zones, plausible gap) and gap (inf when invalid)."""
@@ -839,8 +906,13 @@ class ContactSearch:
         ok = conv & inside & (g > -self.max_penetration)
         return ok, np.where(ok, g, np.inf)
 
-    def _multistart(self, x0, pc, rP, AP, store, it0, max_iter=None):
-        """Newton from several seeds per problem side by side; keep the lowest valid gap."""
+    def _multistart(self, x0, pc, rP, AP, store, it0, max_iter=None, scan_out=None):
+        """Newton from several seeds per problem side by side; keep the lowest valid gap.
+
+        With ``scan_out`` (the bracketed scan seeds), scan seeds at a stationary point that
+        Newton did not solve are handed to :meth:`_rescue`; its result replaces the Newton
+        result where its gap is lower.
+        """
         P = rP.shape[0]
         m = x0.shape[0] // P
         pcm = self._rep(pc, m)
@@ -848,14 +920,250 @@ class ContactSearch:
                                              np.concatenate([AP] * m), max_iter=max_iter)
         _, g = self._valid_gap(x, conv, info, pcm)
         g = g.reshape(m, P)
+        # seeds that Newton did not solve (converged inside the zones; a solved seed may still
+        # be invalid by a too deep penetration, which no second attempt changes)
+        solved = (conv & np.all((x > pcm["lo_e"]) & (x < pcm["hi_e"]), axis=1)).reshape(m, P)
+        if scan_out is not None:
+            # a scan seed at a stationary point that Newton could not solve is refined by
+            # _rescue, unless a solved seed already gave a lower gap
+            fail = np.stack([(q[:, 4] > 0.5) for q in scan_out]) & ~solved[m - len(scan_out):]
+            lost = np.any(fail, axis=0)
+            scan_out = [np.where(f[:, None], q, np.where(np.arange(q.shape[1]) == 4, 0.0, q))
+                        for f, q in zip(fail, scan_out)]
+        else:
+            lost = ~np.any(solved, axis=0)
         best = np.argmin(g, axis=0)  # first seed (the warm start) wins ties
         sel = best * P + np.arange(P)
         info1 = {k: v[sel] for k, v in info.items()}
-        res = self._finish(x[sel], H0[sel], conv[sel], pc, info1, it0 + it)
+        x, H0, conv = x[sel], H0[sel], conv[sel]
+        if scan_out is not None and np.any(lost):
+            bad = np.nonzero(lost)[0]
+            pcb = {k: (v[bad] if isinstance(v, np.ndarray) else v) for k, v in pc.items()}
+            x2, H2, c2, info2, it2 = self._rescue(pcb, rP[bad], AP[bad], [q[bad] for q in scan_out],
+                                                  newton=max_iter is not None)
+            v2, g2 = self._valid_gap(x2, c2, info2, pcb)
+            v2 &= g2 < g[best, np.arange(P)][bad]
+            if np.any(v2):
+                info1 = self._gsv(x, pc, info1)
+                j = bad[v2]
+                x[j], H0[j], conv[j] = x2[v2], H2[v2], c2[v2]
+                for k in info1:
+                    info1[k][j] = info2[k][v2]
+            it += it2
+        res = self._finish(x, H0, conv, pc, info1, it0 + it)
         if store:
-            self._x_prev, self._x = None, x[sel]
+            self._x_prev, self._x = None, x
             self._valid_prev = res.valid.ravel()
         return res
+
+    def _gsv(self, x, pc, info):
+        """Outputs in the compiled kernel's form dict(gap, S, V) (copies)."""
+        if "S" in info:
+            return {k: np.array(v, copy=True) for k, v in info.items()}
+        gap, S, V = self._outputs(x, pc, info)
+        return dict(gap=np.array(gap), S=np.array(S), V=np.array(V))
+
+    def _rescue(self, pc, rP, AP, scan_out, newton=True):
+        """Second chance for scan seeds that Newton did not solve (flag column 4 set).
+
+        Each such seed is solved again with the full iteration count (``newton``: the first
+        pass had the shorter re-seeding limit) and, if that fails too, refined by
+        :meth:`_robust` in its bracket; the lowest valid gap per problem is returned as
+        x, H, conv, info (gap, S, V), passes (gap +inf where nothing was found).
+        """
+        P = rP.shape[0]
+        x = np.array(scan_out[0][:, :4])
+        H = np.full((P, 4), np.inf)
+        conv = np.zeros(P, dtype=bool)
+        info = dict(gap=np.full(P, np.inf), S=np.full((P, 11), np.nan), V=np.full((P, 3, 3), np.nan))
+        gbest = np.full(P, np.inf)
+        it = 0
+
+        def merge(todo, xn, Hn, cn, infn, gn):
+            better = gn < gbest[todo]
+            j = todo[better]
+            x[j], H[j], conv[j], gbest[j] = xn[better], Hn[better], cn[better], gn[better]
+            for k, v in info.items():
+                v[j] = infn[k][better]
+
+        for q in scan_out:
+            todo = np.nonzero(q[:, 4] > 0.5)[0]
+            if todo.size and newton:
+                pct = {k: (v[todo] if isinstance(v, np.ndarray) else v) for k, v in pc.items()}
+                xn, Hn, cn, itn, infn = self._newton(q[todo, :4], pct, rP[todo], AP[todo])
+                it += itn
+                _, gn = self._valid_gap(xn, cn, infn, pct)
+                merge(todo, xn, Hn, cn, self._gsv(xn, pct, infn), gn)
+                solved = cn & np.all((xn > pct["lo_e"]) & (xn < pct["hi_e"]), axis=1)
+                todo = todo[~solved]
+            if todo.size:
+                pct = {k: (v[todo] if isinstance(v, np.ndarray) else v) for k, v in pc.items()}
+                xn, Hn, cn, infn, itn = self._robust(q[todo, :4], pct, rP[todo], AP[todo],
+                                                     q[todo, 5], q[todo, 6])
+                it += itn
+                _, gn = self._valid_gap(xn, cn, infn, pct)
+                merge(todo, xn, Hn, cn, infn, gn)
+        return x, H, conv, info, it
+
+    def _reduced(self, x, pc, rP, AT, iters=12):
+        """Solve h1 = h3 = h4 = 0 for (theta, s, u) at the fixed wheel coordinate y = x[:, 1].
+
+        Returns x, h (all four residuals), info (numpy form) and psi: the gap g = d . n of the
+        wheel point nearest to the rail, +inf where the rail point left the rail's range or the
+        iteration did not converge.  psi(y) is the signed distance of the wheel profile line y
+        from the rail, and dpsi/dy = n . t_y = h2 (envelope theorem): the four-condition
+        solutions are the stationary points of psi.
+        """
+        k3 = np.array([0, 2, 3])
+        x = x.copy()
+        lo, hi = pc["lo"][:, k3], pc["hi"][:, k3]
+        ms = self._maxstep[k3]
+        for _ in range(iters):
+            h, J, info = self._residual_jac(x, pc, rP, AT)
+            Js = J[:, k3][:, :, k3]
+            with np.errstate(all="ignore"):
+                try:
+                    dx = -np.linalg.solve(Js, h[:, k3, None])[:, :, 0]
+                except np.linalg.LinAlgError:
+                    dx = np.zeros((x.shape[0], 3))
+                    ok = np.abs(np.linalg.det(Js)) > 1e-300
+                    dx[ok] = -np.linalg.solve(Js[ok], h[ok][:, k3, None])[:, :, 0]
+            dx = np.where(np.isfinite(dx), dx, 0.0)
+            dx *= np.min(np.minimum(1.0, ms / (np.abs(dx) + 1e-300)), axis=1)[:, None]
+            x[:, k3] = np.clip(x[:, k3] + dx, lo, hi)
+            if np.max(np.abs(dx)) < 1e-13:  # converged (quadratically) to round-off
+                break
+        if np.max(np.abs(dx)) >= 1e-13:
+            h, _, info = self._residual_jac(x, pc, rP, AT)
+        g = np.einsum("ij,ij->i", info["d"], info["n"])
+        ok = ((np.abs(h[:, 0]) < 1e-9) & (np.abs(h[:, 2]) < 1e-10) & (np.abs(h[:, 3]) < 1e-10)
+              & (x[:, 3] > pc["lo_e"][:, 3]) & (x[:, 3] < pc["hi_e"][:, 3]) & np.isfinite(g))
+        return x, h, info, np.where(ok, g, np.inf)
+
+    def _robust(self, x0, pc, rP, AP, ylo, yhi, tol=1e-9, n_dense=64, max_shift=6):
+        """Robust refinement: the minimum of psi(y) (see :meth:`_reduced`) in a bracket.
+
+        Newton on the four conditions fails where the Jacobian is (nearly) singular or jumps:
+        a concave flange root nearly conformal with the rail's gauge corner (S1002 R13 root on
+        the UIC60 R13 corner), a stationary point at a joint of profile sections where the
+        slope or curvature jumps (the S1002 root/flank joint has a slope step of about 1e-5),
+        or the ripples of a spline through coarsely sampled, rounded points (slope noise of
+        order 1e-4 where the tread is nearly conformal with the rail crown makes many
+        stationary points).  The gap psi(y) of the wheel profile line y is continuous; here
+        it is sampled at ``n_dense`` points of the bracket [ylo, yhi] (one vectorised call).
+        From the lowest sample Newton on the four conditions is tried once more; where it
+        converges between the neighbouring samples to a gap no higher than the sample's, that
+        is the result.  Otherwise the minimum is refined by golden-section search (Kiefer
+        1953; no derivative needed) between the neighbours of the lowest sample to ``tol``
+        (m) on y.  A lowest sample at
+        a bracket end that is not a zone end moves the bracket on by its width (at most
+        ``max_shift`` times).  At a smooth minimum the result is the four-condition solution
+        (h2 = dpsi/dy = 0 to the tolerance); at a slope step it is the minimum distance.
+
+        Returns x, H, conv, info (gap, S, V), passes.
+        """
+        AT = np.swapaxes(AP, 1, 2)
+        P = x0.shape[0]
+        zlo, zhi = pc["lo_e"][:, 1], pc["hi_e"][:, 1]
+        a_all = np.clip(np.minimum(ylo, yhi), zlo, zhi)
+        b_all = np.clip(np.maximum(ylo, yhi), zlo, zhi)
+        width = np.maximum(b_all - a_all, 1e-5)
+        b_all = np.minimum(a_all + width, zhi)
+        x_all = np.array(x0, dtype=float)
+        y_all = np.clip(x_all[:, 1], zlo, zhi)
+        passes = 0
+        moving = np.ones(P, dtype=bool)
+        found = np.zeros(P, dtype=bool)
+        t = np.linspace(0.0, 1.0, n_dense)
+
+        def sub(d, ix):
+            return {key: (v[ix] if isinstance(v, np.ndarray) else v) for key, v in d.items()}
+
+        for _ in range(max_shift + 1):
+            idx = np.nonzero(moving)[0]
+            k = idx.size
+            a0, b0 = a_all[idx], b_all[idx]
+            # dense samples: warm start with the rail point moved along with the wheel point
+            Y = a0[:, None] + (b0 - a0)[:, None] * t[None, :]  # (k, n)
+            Xs = np.repeat(x_all[idx], n_dense, axis=0)
+            Xs[:, 3] += Y.ravel() - Xs[:, 1]
+            Xs[:, 1] = Y.ravel()
+            pcr = {key: (np.repeat(v[idx], n_dense, axis=0) if isinstance(v, np.ndarray) else v)
+                   for key, v in pc.items()}
+            Xs[:, 3] = np.clip(Xs[:, 3], pcr["lo_e"][:, 3], pcr["hi_e"][:, 3])
+            Xs, _, _, G = self._reduced(Xs, pcr, np.repeat(rP[idx], n_dense, axis=0),
+                                        np.repeat(AT[idx], n_dense, axis=0))
+            passes += 1
+            G = G.reshape(k, n_dense)
+            Xs = Xs.reshape(k, n_dense, 4)
+            ar = np.arange(k)
+            im = np.argmin(G, axis=1)
+            gm, xm = G[ar, im], Xs[ar, im]
+            has = np.isfinite(gm)
+            found[idx] = has
+            a = Y[ar, np.maximum(im - 1, 0)]
+            b = Y[ar, np.minimum(im + 1, n_dense - 1)]
+            pci = sub(pc, idx)
+            # Newton on the four conditions from the lowest sample: where it converges between
+            # the neighbouring samples to a gap no higher than the sample's (a smooth minimum),
+            # that is the result
+            xn, _, cn, itn, infn = self._newton(xm, pci, rP[idx], AP[idx])
+            passes += itn
+            gn = infn["gap"] if "gap" in infn else np.einsum("ij,ij->i", infn["d"], infn["n"])
+            newton_ok = (has & cn & np.all((xn > pci["lo_e"]) & (xn < pci["hi_e"]), axis=1)
+                         & (xn[:, 1] >= a) & (xn[:, 1] <= b) & (gn <= gm + 1e-12))
+            yb, xb = np.where(newton_ok, xn[:, 1], xm[:, 1]), np.where(newton_ok[:, None], xn, xm)
+            # elsewhere golden section between the neighbours of the lowest sample
+            gi = np.nonzero(has & ~newton_ok)[0]
+            if gi.size:
+                pcg, rg_, Ag = sub(pci, gi), rP[idx][gi], AT[idx][gi]
+
+                def psi(y, xs, pcg=pcg, rg_=rg_, Ag=Ag):
+                    xs = xs.copy()
+                    xs[:, 1] = y
+                    xs, _, _, g = self._reduced(xs, pcg, rg_, Ag)
+                    return xs, g
+
+                ag, bg, x_start = a[gi], b[gi], xm[gi]
+                gr = 0.5 * (np.sqrt(5.0) - 1.0)
+                c = bg - gr * (bg - ag)
+                d = ag + gr * (bg - ag)
+                xc, fc = psi(c, x_start)
+                xd, fd = psi(d, x_start)
+                n_gold = max(int(np.ceil(np.log(tol / max(np.max(bg - ag), tol)) / np.log(gr))), 1)
+                passes += n_gold + 2
+                for _ in range(n_gold):
+                    left = fc <= fd  # the minimum lies in [a, d]
+                    bg = np.where(left, d, bg)
+                    ag = np.where(left, ag, c)
+                    d_new = np.where(left, c, ag + gr * (bg - ag))
+                    c_new = np.where(left, bg - gr * (bg - ag), d)
+                    xe, fe = psi(np.where(left, c_new, d_new), np.where(left[:, None], xc, xd))
+                    xc, fc, xd, fd = (np.where(left[:, None], xe, xd), np.where(left, fe, fd),
+                                      np.where(left[:, None], xc, xe), np.where(left, fc, fe))
+                    c, d = c_new, d_new
+                pick = fc <= fd
+                better = np.where(pick, fc, fd) <= gm[gi]  # else keep the lowest sample
+                yb[gi] = np.where(better, np.where(pick, c, d), yb[gi])
+                xb[gi] = np.where(better[:, None], np.where(pick[:, None], xc, xd), xb[gi])
+            y_all[idx], x_all[idx] = yb, xb
+            # the lowest sample at a bracket end (not a zone end): the minimum lies beyond it
+            at_lo = has & (im == 0) & (a0 > zlo[idx] + tol)
+            at_hi = has & (im == n_dense - 1) & (b0 < zhi[idx] - tol)
+            moving[:] = False
+            moving[idx] = at_lo | at_hi
+            if not np.any(moving):
+                break
+            w = width[idx]
+            a_all[idx] = np.clip(np.where(at_lo, a0 - w, np.where(at_hi, b0 - 0.1 * w, a0)),
+                                 zlo[idx], zhi[idx])
+            b_all[idx] = np.clip(np.where(at_hi, b0 + w, np.where(at_lo, a0 + 0.1 * w, b0)),
+                                 zlo[idx], zhi[idx])
+        x_all[:, 1] = y_all
+        x, h, info, g = self._reduced(x_all, pc, rP, AT)
+        passes += 1
+        conv = np.isfinite(g) & found & ~moving
+        return x, h, conv, self._gsv(x, pc, info), passes
 
     def reset(self):
         """Forget the warm start."""

@@ -15,12 +15,18 @@ import numpy as np
 import pandas as pd
 
 from core.contact_laws import hertz_from_load
+from core.errors import InputError
 
 from .creep import get_creep_model
 
-__all__ = ["creep_curve", "plot_creep_curve", "semi_axes_from_curvatures"]
+__all__ = ["SEMI_AXIS_RANGE", "creep_curve", "plot_creep_curve", "semi_axes_from_curvatures"]
 
 _CREEPAGES = {"xi": "xi [-]", "eta": "eta [-]", "phi": "phi [1/m]"}
+
+#: Plausible semi-axes (m) of a wheel-rail contact given by hand: from 0.05 mm (a lightly
+#: loaded flange tip) to 0.1 m (a fully conformal worn contact is below 20 mm); a value outside
+#: is taken for a unit slip (micrometres: metres given where mm are expected, or the reverse).
+SEMI_AXIS_RANGE = (5e-5, 0.1)
 
 
 def semi_axes_from_curvatures(normal_force, A, B, E, nu):
@@ -49,10 +55,12 @@ def creep_curve(models="polach2000", creepage: str = "xi", values=None, *, norma
         Swept values ([-] for xi, eta; [1/m] for phi); default 101 points over +-0.01 (xi, eta) or
         +-2 1/m (phi).
     normal_force : float
-        Normal load N [N].
+        Normal load N [N], > 0.
     a, b : float, optional
-        Semi-axes along the rolling direction and lateral [m].  If omitted, computed by Hertz from
-        ``A``, ``B`` [1/m] and ``E`` [Pa], ``nu`` (same material for wheel and rail).
+        Semi-axes along the rolling direction and lateral [m], within :data:`SEMI_AXIS_RANGE`
+        (an InputError names a value outside, e.g. micrometres from a unit slip).  If omitted,
+        computed by Hertz from ``A``, ``B`` [1/m] and ``E`` [Pa], ``nu`` (same material for
+        wheel and rail).
     G : float, optional
         Shear modulus [Pa]; default E/(2(1 + nu)) (E required then).
     nu, mu : float
@@ -71,10 +79,27 @@ def creep_curve(models="polach2000", creepage: str = "xi", values=None, *, norma
     """
     if creepage not in _CREEPAGES:
         raise ValueError(f"creepage must be one of {sorted(_CREEPAGES)}, got {creepage!r}")
+    try:
+        N = float(normal_force)
+    except (TypeError, ValueError):
+        raise InputError(f"creep curve: normal_force = {normal_force!r} N is not a number") from None
+    if not (np.isfinite(N) and N > 0):
+        raise InputError(f"creep curve: normal_force = {normal_force!r} N must be positive (the "
+                         "curve is normalised by mu N; a creep curve of an unloaded contact is "
+                         "zero)")
     if a is None or b is None:
         if A is None or B is None or E is None:
             raise ValueError("give the semi-axes a, b or the curvatures A, B with E")
         a, b = semi_axes_from_curvatures(normal_force, A, B, E, nu)
+    else:
+        for key, val in (("a", a), ("b", b)):
+            v = float(val)
+            if not (SEMI_AXIS_RANGE[0] <= v <= SEMI_AXIS_RANGE[1]):
+                raise InputError(
+                    f"creep curve: semi-axis {key} = {val!r} m is implausible for a wheel-rail "
+                    f"contact (expected {SEMI_AXIS_RANGE[0]:g} to {SEMI_AXIS_RANGE[1]:g} m, e.g. "
+                    f"0.006); semi-axes are in metres"
+                    + (" -- was it given in millimetres?" if v > SEMI_AXIS_RANGE[1] else ""))
     if G is None:
         if E is None:
             raise ValueError("give G or E")

@@ -49,6 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from core.curves import PiecewisePoly
+from core.errors import DataFileError, InputError
 from core.paths import data_path
 
 __all__ = [
@@ -59,10 +60,40 @@ __all__ = [
     "s1002_exact",
     "uic60_exact",
     "read_profile_file",
+    "data_resolution",
+    "R0_RANGE",
+    "MIN_FLANGE_HEIGHT",
 ]
 
 DATA_DIR = data_path("railway", must_exist=False)
 _MM = 1e-3
+
+#: Smallest flange height (m) of a wheel profile: new S1002 28 mm, worn flanges grow higher;
+#: a profile with less at negative y is taken for a file read with the wrong signs.
+MIN_FLANGE_HEIGHT = 0.010
+
+#: Plausible nominal rolling radii (m): from a 1:5 scale roller-rig wheel (about 0.09 m) to the
+#: largest locomotive wheels (about 1 m); a value outside is taken for a unit slip.
+R0_RANGE = (0.05, 1.5)
+
+
+def data_resolution(values, max_decimals=9):
+    """Quantum of numbers written with a fixed number of decimals (same unit as the values).
+
+    The smallest 10^-k (k = 0 ... ``max_decimals``) of which every value is an integer
+    multiple (to 1e-4 of the quantum); 0.0 when there is none (full-precision data).  For a
+    profile exported in mm with 4 decimals it is 1e-4 mm: the data cannot resolve heights, nor
+    slopes over a spacing h, better than that quantum (slopes to about quantum / h).
+    """
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return 0.0
+    for k in range(max_decimals + 1):
+        s = v * 10.0**k
+        if np.all(np.abs(s - np.round(s)) < 1e-4):
+            return 10.0**-k
+    return 0.0
 
 
 # ---------------------------------------------------------------------------------------------
@@ -138,10 +169,17 @@ def _uic60_half_sections():
     """Sections of the UIC60 head for u >= 0 (mm): (u_lo, u_hi, centre_u, centre_v, R)."""
     g = _UIC60
     # crown centre 300 below crown; v = centre_v + sqrt(R^2 - (u-cu)^2)
-    # the tangency points follow from the arc centres (arcs mutually tangent)
+    # the tangency points follow from the arc centres (arcs mutually tangent).  The centre
+    # depths printed to 1e-3 mm (80.135, 14.909) leave the R80 arc 0.23 um inside the R300
+    # arc (|c300 - c80| = 219.99977 instead of 300 - 80), a 0.21 um step of the head at
+    # |u| = 10.5 mm that a contact search sees; the depths are therefore taken from the
+    # tangency conditions |c300 - c80| = R300 - R80, |c80 - c13| = R80 - R13 at the printed
+    # lateral positions (80.13480, 14.90884 mm: within 0.3 um of the printed values).
+    d80 = g["R300"] - np.sqrt((g["R300"] - g["R80"]) ** 2 - g["c80_u"] ** 2)
+    d13 = d80 - np.sqrt((g["R80"] - g["R13"]) ** 2 - (g["c13_u"] - g["c80_u"]) ** 2)
     c300 = np.array([0.0, -g["R300"]])
-    c80 = np.array([g["c80_u"], -g["c80_d"]])
-    c13 = np.array([g["c13_u"], -g["c13_d"]])
+    c80 = np.array([g["c80_u"], -d80])
+    c13 = np.array([g["c13_u"], -d13])
     t1 = c300 + g["R300"] * (c80 - c300) / np.linalg.norm(c80 - c300)
     t2 = c80 + g["R80"] * (c13 - c80) / np.linalg.norm(c13 - c80)
     # flank 1:20 tangent to R13: outward normal (1, -0.05)/|.| in (u, v)
@@ -188,14 +226,14 @@ def _validate_xy(x, z, source):
     x = np.asarray(x, dtype=float)
     z = np.asarray(z, dtype=float)
     if x.ndim != 1 or x.shape != z.shape:
-        raise ValueError(f"{source}: lateral and vertical columns must be 1-D of equal length")
+        raise InputError(f"{source}: lateral and vertical columns must be 1-D of equal length")
     if x.size < 4:
-        raise ValueError(f"{source}: at least 4 profile points are needed, got {x.size}")
+        raise InputError(f"{source}: at least 4 profile points are needed, got {x.size}")
     for name, a in (("lateral", x), ("vertical", z)):
         bad = ~np.isfinite(a)
         if np.any(bad):
             i = int(np.argmax(bad))
-            raise ValueError(f"{source}: {name} coordinate of point {i} is {a[i]!r} (not finite)")
+            raise InputError(f"{source}: {name} coordinate of point {i} is {a[i]!r} (not finite)")
     dx = np.diff(x)
     if np.all(dx < 0):
         x, z = x[::-1], z[::-1]
@@ -203,7 +241,7 @@ def _validate_xy(x, z, source):
     if not np.all(dx > 0):
         sign = 1.0 if np.sum(dx > 0) >= np.sum(dx < 0) else -1.0
         i = int(np.argmax(sign * dx <= 0)) + 1
-        raise ValueError(
+        raise InputError(
             f"{source}: lateral coordinate is not strictly monotonic at point {i} "
             f"(value {x[i]!r} after {x[i - 1]!r}); trim the profile to a graph over the lateral "
             f"coordinate")
@@ -221,17 +259,17 @@ def read_profile_file(path):
                 continue
             parts = [p for p in re.split(r"[,;\s]+", s) if p]
             if len(parts) < 2:
-                raise ValueError(f"{path}:{lineno}: expected two columns, got {s!r}")
+                raise DataFileError(f"{path}:{lineno}: expected two columns, got {s!r}")
             try:
                 a, b = float(parts[0]), float(parts[1])
             except ValueError:
                 if not xs:  # header line
                     continue
-                raise ValueError(f"{path}:{lineno}: non-numeric value in {s!r}") from None
+                raise DataFileError(f"{path}:{lineno}: non-numeric value in {s!r}") from None
             xs.append(a)
             zs.append(b)
     if not xs:
-        raise ValueError(f"{path}: no profile points found")
+        raise DataFileError(f"{path}: no profile points found")
     return np.array(xs), np.array(zs)
 
 
@@ -261,9 +299,13 @@ class ProfileCurve:
         Label used in messages and tables.
     """
 
-    def __init__(self, poly: PiecewisePoly, name: str):
+    def __init__(self, poly: PiecewisePoly, name: str, resolution: float = 0.0):
         self.poly = poly
         self.name = name
+        #: vertical resolution of the data (m): 0 for an analytic profile, the quantum of the
+        #: written values for measured points (e.g. 1e-7 m for values in mm with 4 decimals);
+        #: no geometric result can be trusted below it
+        self.resolution = float(resolution)
 
     @property
     def x_min(self) -> float:
@@ -277,7 +319,7 @@ class ProfileCurve:
         """Return (f, df/dx, d2f/dx2) at x (m); shapes follow x."""
         x = np.asarray(x, dtype=float)
         if np.any(~np.isfinite(x)):
-            raise ValueError(f"{self.name}: non-finite profile coordinate {x[~np.isfinite(x)][0]!r}")
+            raise InputError(f"{self.name}: non-finite profile coordinate {x[~np.isfinite(x)][0]!r}")
         return self.poly(x)
 
     def curvature(self, x):
@@ -308,41 +350,68 @@ class WheelProfile(ProfileCurve):
         Lateral coordinate of the flange back face (m), -0.070 for S1002.
     y_split : float, optional
         Boundary between the tread and flange zones (m).  Default: where the convex flange
-        (flank and tip, F'' <= 0) meets the concave flange root (F'' > 0), so that the flange
-        zone is convex; -38.43 mm for S1002 (joint of the R13 root arc and the 70 deg flank).
+        (flank and tip, F'' <= 0) meets the concave flange root (F'' > 0 over at least
+        0.5 mm), so that the flange zone is convex; -38.43 mm for S1002 (joint of the R13 root
+        arc and the 70 deg flank).
     y_flange_min : float, optional
         Lowest y admitted for flange contact (m); default the flange tip (maximum of F).
     name : str
     """
 
     def __init__(self, poly, r0=0.46, y_back=-0.070, y_split=None, y_flange_min=None,
-                 name="wheel"):
-        super().__init__(poly, name)
+                 name="wheel", resolution=0.0):
+        super().__init__(poly, name, resolution)
         for key, val in (("r0", r0), ("y_back", y_back)):
             if not np.isfinite(val):
-                raise ValueError(f"{name}: {key} = {val!r} is not finite")
+                raise InputError(f"{name}: {key} = {val!r} is not finite")
         if r0 <= 0.0:
-            raise ValueError(f"{name}: nominal rolling radius r0 = {r0!r} m must be positive")
+            raise InputError(f"{name}: nominal rolling radius r0 = {r0!r} m must be positive")
+        if not (R0_RANGE[0] <= r0 <= R0_RANGE[1]):
+            raise InputError(
+                f"{name}: nominal rolling radius r0 = {r0!r} m is implausible (expected "
+                f"{R0_RANGE[0]:g} to {R0_RANGE[1]:g} m, e.g. 0.46); r0 is in metres"
+                + (" -- was it given in millimetres?" if r0 > R0_RANGE[1] else ""))
         self.r0 = float(r0)
         self.y_back = float(y_back)
         ys = np.linspace(self.x_min, min(0.0, self.x_max), 4001)
         F, _, F2 = self.poly(ys)
         i_tip = int(np.argmax(F))
         self.y_tip = float(ys[i_tip])
+        # the flange lies at negative y and F grows towards it (the convention of S1002 and of
+        # every sign option of the readers): a profile read with the wrong flange side or
+        # vertical sign has no such flange -- refuse it instead of computing with it
+        y0 = min(max(0.0, self.x_min), self.x_max)
+        F0 = float(self.poly(np.array([y0]))[0][0])
+        h_neg = float(F[i_tip]) - F0
+        yp = np.linspace(y0, self.x_max, 2001)
+        h_pos = float(np.max(self.poly(yp)[0])) - F0
+        if not (h_neg >= MIN_FLANGE_HEIGHT and h_neg > h_pos):
+            raise InputError(
+                f"{name}: no flange at negative lateral coordinates (the radius increase rises "
+                f"{h_neg * 1e3:.3g} mm above the taping line towards negative y and "
+                f"{h_pos * 1e3:.3g} mm towards positive y; a flange is at least "
+                f"{MIN_FLANGE_HEIGHT * 1e3:g} mm high): check the flange side (flange_side="
+                "'positive' mirrors y) and the vertical sign (vertical='height' flips it)")
         if y_flange_min is None:
             y_flange_min = self.y_tip
         if y_split is None:
             # the flange proper is convex (F'' <= 0: flank and flange tip); the root between it
-            # and the tread is concave.  Split at the first point, going from the flange tip
-            # towards the taping line, where the profile turns concave (F'' > 0).
+            # and the tread is concave.  Split where, going from the flange tip towards the
+            # taping line, the profile turns concave (F'' > 0) for good: the first stretch of
+            # F'' > 0 at least 0.5 mm long.  (A cubic spline through sampled points rings
+            # around the curvature jumps of the flank's joints: F'' changes sign along the
+            # straight flank in stretches of about one sample spacing, which must not count.)
             m = (ys > self.y_tip) & (F2 > 1e-6)
-            if not np.any(m):
-                raise ValueError(f"{name}: no concave flange root found; give y_split explicitly")
-            y_split = float(ys[np.argmax(m)])
+            edges = np.diff(np.concatenate([[0], m.astype(int), [0]]))
+            starts, ends = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]
+            long_ = [a for a, b in zip(starts, ends) if ys[b - 1] - ys[a] >= 5e-4]
+            if not long_:
+                raise InputError(f"{name}: no concave flange root found; give y_split explicitly")
+            y_split = float(ys[long_[0]])
         self.y_split = float(y_split)
         self.y_flange_min = float(y_flange_min)
         if not (self.x_min <= self.y_flange_min < self.y_split < self.x_max):
-            raise ValueError(
+            raise InputError(
                 f"{name}: need y_min <= y_flange_min < y_split < y_max, got {self.x_min}, "
                 f"{self.y_flange_min}, {self.y_split}, {self.x_max}")
 
@@ -377,7 +446,7 @@ class WheelProfile(ProfileCurve):
 
     @classmethod
     def from_points(cls, y, F, r0, y_back, flange_side="negative", vertical="radius_increase",
-                    smoothing=None, name="measured wheel", source=None, **kw):
+                    smoothing=None, name="measured wheel", source=None, resolution=None, **kw):
         """Wheel profile from measured points (mm), fitted with a C2 cubic (smoothing) spline.
 
         Parameters
@@ -391,12 +460,17 @@ class WheelProfile(ProfileCurve):
         smoothing : float, optional
             ``lam`` of :func:`scipy.interpolate.make_smoothing_spline` (mm^3 units); None
             interpolates.
+        resolution : float, optional
+            Vertical resolution of the data (mm); default :func:`data_resolution` of ``F``
+            (1e-4 mm for values written with 4 decimals).  Stored in metres as
+            ``self.resolution``; :func:`railway.contact_geometry.rigid_contact` accepts a
+            rigid solution to this level.
         """
         source = source or name
         if flange_side not in ("negative", "positive"):
-            raise ValueError(f"{source}: flange_side must be 'negative' or 'positive', got {flange_side!r}")
+            raise InputError(f"{source}: flange_side must be 'negative' or 'positive', got {flange_side!r}")
         if vertical not in ("radius_increase", "height"):
-            raise ValueError(f"{source}: vertical must be 'radius_increase' or 'height', got {vertical!r}")
+            raise InputError(f"{source}: vertical must be 'radius_increase' or 'height', got {vertical!r}")
         y = np.asarray(y, dtype=float)
         F = np.asarray(F, dtype=float)
         if flange_side == "positive":
@@ -405,9 +479,10 @@ class WheelProfile(ProfileCurve):
             F = -F
         y, F = _validate_xy(y, F, source)
         if y_back > y[0]:
-            raise ValueError(f"{source}: flange back y_back = {y_back!r} mm lies inside the profile")
+            raise InputError(f"{source}: flange back y_back = {y_back!r} mm lies inside the profile")
+        res = data_resolution(F) if resolution is None else float(resolution)
         poly = _spline_ppoly(y * _MM, F * _MM, smoothing)
-        return cls(poly, r0=r0, y_back=y_back * _MM, name=name, **kw)
+        return cls(poly, r0=r0, y_back=y_back * _MM, name=name, resolution=res * _MM, **kw)
 
     @classmethod
     def from_file(cls, path, r0, y_back=-70.0, **kw):
@@ -441,16 +516,17 @@ class RailProfile(ProfileCurve):
 
     @classmethod
     def from_points(cls, u, v, field_side="positive", vertical="height", smoothing=None,
-                    name="measured rail", source=None):
+                    name="measured rail", source=None, resolution=None):
         """Rail profile from measured points (mm), fitted with a C2 cubic (smoothing) spline.
 
         The crown is shifted to v = 0 (highest point of the un-inclined profile).
+        ``resolution`` (mm) as in :meth:`WheelProfile.from_points`.
         """
         source = source or name
         if field_side not in ("negative", "positive"):
-            raise ValueError(f"{source}: field_side must be 'negative' or 'positive', got {field_side!r}")
+            raise InputError(f"{source}: field_side must be 'negative' or 'positive', got {field_side!r}")
         if vertical not in ("height", "depth"):
-            raise ValueError(f"{source}: vertical must be 'height' or 'depth', got {vertical!r}")
+            raise InputError(f"{source}: vertical must be 'height' or 'depth', got {vertical!r}")
         u = np.asarray(u, dtype=float)
         v = np.asarray(v, dtype=float)
         if field_side == "negative":
@@ -458,8 +534,9 @@ class RailProfile(ProfileCurve):
         if vertical == "depth":
             v = -v
         u, v = _validate_xy(u, v, source)
+        res = data_resolution(v) if resolution is None else float(resolution)
         v = v - np.max(v)
-        return cls(_spline_ppoly(u * _MM, v * _MM, smoothing), name=name)
+        return cls(_spline_ppoly(u * _MM, v * _MM, smoothing), name=name, resolution=res * _MM)
 
     @classmethod
     def from_file(cls, path, **kw):

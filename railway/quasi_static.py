@@ -26,13 +26,14 @@ import numpy as np
 import pandas as pd
 
 from core.contact_laws import hertz_from_penetration
+from core.errors import InputError
 
 from .contact_geometry import rigid_contact
 from .contact_search import FLANGE, ContactSearch, wheelset_pose
 from .profiles import WheelProfile
 from .track import RailMounting, Track
 
-__all__ = ["quasi_static_contact"]
+__all__ = ["quasi_static_contact", "quasi_static_summary"]
 
 
 def _contact_forces(res, E, nu):
@@ -77,31 +78,38 @@ def quasi_static_contact(lateral, wheel_load, yaw=0.0, wheel=None, rail=None, ga
         One row per shift, side and loaded candidate: ``y [m]``, ``z [m]``, ``roll [rad]``,
         ``side``, ``contact`` (tread/flange), ``N [N]``, ``Fz [N]`` (vertical component),
         ``Fy [N]`` (lateral component, positive to the left), ``penetration [m]``,
-        ``contact angle [rad]``, ``y_wheel [m]``, ``a [m]``, ``b [m]``, ``converged`` (False for
-        a shift whose force balance missed ``tol`` after ``max_iter`` iterations, e.g. deep in
-        flange climbing or where the S1002 contact jumps; its rows show the last iterate).
+        ``contact angle [rad]``, ``y_wheel [m]``, ``a [m]``, ``b [m]``, ``converged`` and
+        ``status``.  A shift whose force balance missed ``tol`` after ``max_iter`` iterations
+        (e.g. deep in flange climbing or where the S1002 contact jumps) has ``converged`` False
+        and status ``"no force balance: ..."``; its rows show the last iterate and must not
+        enter any summary (:func:`quasi_static_summary` leaves them out).  A shift without a
+        rigid contact (out of reach beyond the flange) has one row per side with NaN values
+        and the rigid contact's status.  One shift never stops the others.
 
     Raises
     ------
-    ValueError
-        Non-positive or non-finite load, non-finite shift.
-    RuntimeError
-        If no shift converged.
+    InputError
+        Non-positive, implausibly small or non-finite load, non-finite shift.
     """
-    if not (np.isfinite(wheel_load) and wheel_load > 0):
-        raise ValueError(f"quasi-static contact: wheel load {wheel_load!r} N must be positive")
+    Q = _check_load(wheel_load)
     y = np.atleast_1d(np.asarray(lateral, dtype=float))
     if np.any(~np.isfinite(y)):
-        raise ValueError(f"quasi-static contact: lateral shift {y[~np.isfinite(y)][0]!r} is not finite")
+        raise InputError(f"quasi-static contact: lateral shift {y[~np.isfinite(y)][0]!r} is not finite")
     wheel = wheel if wheel is not None else WheelProfile.s1002()
+    z_all, roll_all, rig, _ = rigid_contact(y, yaw, wheel, rail, gauge, inclination,
+                                            flange_back_spacing, errors="mark")
+    rig_status = rig.extra["status"]
+    ok = rig_status == "ok"
+    y_all = y
+    y, z, roll = y_all[ok], z_all[ok], roll_all[ok]
     n = y.size
-    z, roll, _, _ = rigid_contact(y, yaw, wheel, rail, gauge, inclination, flange_back_spacing)
+    if n == 0:
+        return _assemble([], y_all, rig_status, wheel, Q, yaw)
     mount = RailMounting(rail, gauge=gauge, inclination=inclination)
     track = Track.straight(20.0)
     cs = ContactSearch(track, wheel=wheel, rails=mount, n_wheelsets=3 * n,
                        flange_back_spacing=flange_back_spacing, tol_linear=1e-9)
     s = np.full(3 * n, 10.0)
-    Q = float(wheel_load)
     tol = 1e-6 * Q if tol is None else float(tol)
     # first guess: sink the rigid pose by the Hertz approach of a tread contact under Q
     z = z - 1e-4 * (Q / 1e5) ** (2.0 / 3.0)
@@ -158,10 +166,8 @@ def quasi_static_contact(lateral, wheel_load, yaw=0.0, wheel=None, rail=None, ga
         dr_acc = np.where(keep, dr, dr_acc)
         z = np.where(keep, z + dz, z)
         roll = np.where(keep, roll + dr, roll)
-    converged = np.max(np.abs(Fz[0] - Q), axis=1) < tol
-    if not np.any(converged):
-        raise RuntimeError(f"quasi-static contact: no force balance in {max_iter} iterations "
-                           f"(largest residual {float(np.max(np.abs(Fz[0] - Q)))!r} N)")
+    resid = np.max(np.abs(Fz[0] - Q), axis=1)
+    converged = resid < tol
     nw = 2 * n
     N, a, b = N[:nw], a[:nw], b[:nw]
     rows = []
@@ -179,7 +185,82 @@ def quasi_static_contact(lateral, wheel_load, yaw=0.0, wheel=None, rail=None, ga
                     "penetration [m]": res.penetration[w, c],
                     "contact angle [rad]": res.contact_angle[w, c],
                     "y_wheel [m]": res.y_wheel[w, c], "a [m]": a[w, c], "b [m]": b[w, c],
-                    "converged": bool(converged[i])})
-    df = pd.DataFrame(rows)
+                    "converged": bool(converged[i]),
+                    "status": "ok" if converged[i] else (
+                        f"no force balance: vertical force residual {float(resid[i]):.4g} N "
+                        f"after {max_iter} iterations")})
+    return _assemble(rows, y_all, rig_status, wheel, Q, yaw)
+
+
+_COLUMNS = ["y [m]", "z [m]", "roll [rad]", "side", "contact", "N [N]", "Fz [N]", "Fy [N]",
+            "penetration [m]", "contact angle [rad]", "y_wheel [m]", "a [m]", "b [m]",
+            "converged", "status"]
+
+
+def _assemble(rows, y_all, rig_status, wheel, Q, yaw):
+    """The result table: the solved rows plus one NaN row per side of each shift without a
+    rigid contact, ordered by shift."""
+    for yk, st in zip(y_all, rig_status):
+        if st != "ok":
+            for side in ("left", "right"):
+                row = {c: np.nan for c in _COLUMNS}
+                row.update({"y [m]": float(yk), "side": side, "contact": "none",
+                            "converged": False, "status": str(st)})
+                rows.append(row)
+    df = pd.DataFrame(rows, columns=_COLUMNS)
+    order = {float(v): k for k, v in enumerate(y_all)}
+    df = df.iloc[np.argsort([order[float(v)] for v in df["y [m]"]], kind="stable")]
+    df = df.reset_index(drop=True)
     df.attrs.update(wheel=wheel.name, wheel_load=Q, yaw=float(yaw))
     return df
+
+
+def _check_load(wheel_load):
+    """The wheel load (N) as a float; InputError naming the value for a zero, negative,
+    non-finite or implausibly small load (a load given in kN where N are expected)."""
+    try:
+        Q = float(wheel_load)
+    except (TypeError, ValueError):
+        raise InputError(f"quasi-static contact: wheel load {wheel_load!r} N is not a number") from None
+    if not (np.isfinite(Q) and Q > 0):
+        raise InputError(f"quasi-static contact: wheel load {wheel_load!r} N must be positive")
+    if Q < _MIN_WHEEL_LOAD:
+        raise InputError(f"quasi-static contact: wheel load {wheel_load!r} N is implausibly small "
+                         f"(below {_MIN_WHEEL_LOAD:g} N); the load is in newtons, e.g. 100e3 for "
+                         "100 kN")
+    return Q
+
+
+#: Smallest plausible vertical wheel load (N): a 1:10 scale model of a 100 kN wheel carries 100 N.
+_MIN_WHEEL_LOAD = 100.0
+
+
+def quasi_static_summary(df):
+    """Summary figures of a :func:`quasi_static_contact` table, from converged rows only.
+
+    Rows with ``converged`` False (no force balance, or no rigid contact) are left out of
+    every figure and counted instead.
+
+    Returns
+    -------
+    dict
+        ``shifts`` (number of shifts), ``converged shifts``, ``excluded shifts [m]`` (list of
+        the shifts left out, each with its status in ``excluded status``), ``max N [N]``,
+        ``max |Fy| [N]`` (NaN without a converged shift), ``two-point pairs`` (number of
+        (shift, side) pairs with two loaded contacts) and ``first two-point shift [m]``.
+    """
+    shifts = pd.unique(df["y [m]"])
+    good = df[df["converged"].astype(bool)]
+    bad = df[~df["converged"].astype(bool)].drop_duplicates("y [m]")
+    two = good.groupby(["y [m]", "side"]).size()
+    two = two[two > 1]
+    return {
+        "shifts": len(shifts),
+        "converged shifts": int(good["y [m]"].nunique()),
+        "excluded shifts [m]": [float(v) for v in bad["y [m]"]],
+        "excluded status": [str(v) for v in bad["status"]],
+        "max N [N]": float(good["N [N]"].max()) if len(good) else float("nan"),
+        "max |Fy| [N]": float(good["Fy [N]"].abs().max()) if len(good) else float("nan"),
+        "two-point pairs": len(two),
+        "first two-point shift [m]": float(min(v[0] for v in two.index)) if len(two) else float("nan"),
+    }

@@ -71,14 +71,22 @@ def _fig(nrows=1, ncols=1, size=(7, 4)):
 
 # ---------------------------------------------------------------------------------------------
 def _run_contact_geometry(ctx):
-    from .contact_geometry import conicity_table, contact_geometry_table, flange_contact_onset
+    from .contact_geometry import (
+        conicity_table,
+        contact_geometry_table,
+        contact_transitions,
+        flange_contact_onset,
+    )
 
     n = 101 if ctx.fast else 401
     y = np.linspace(-0.010, 0.010, n)
     df = contact_geometry_table(y)
     con = conicity_table(df, [0.002, 0.003, 0.004])
-    y_f, g_f = flange_contact_onset(df)
-    picks = [0.001, 0.002, 0.003, 0.004, 0.005, 0.006, y_f]
+    trans = contact_transitions(df)  # jumps and flange onset, by bisection to 0.1 um
+    y_f, g_f = flange_contact_onset(df, transitions=trans)  # exact, between the rows
+    # excerpt rows: 1 ... 6 mm and the first row with flange contact (y_f lies between rows)
+    first_flange = float(df[(df["y [m]"] > 0) & df["flange_L"]]["y [m]"].min())
+    picks = [0.001, 0.002, 0.003, 0.004, 0.005, 0.006, first_flange]
     idx = [int(np.argmin(np.abs(df["y [m]"].to_numpy() - p))) for p in picks]
     table = _display_units(df)
     excerpt = table.iloc[idx][["lateral shift [mm]", "delta_r [mm]", "gamma_L [deg]", "gamma_R [deg]",
@@ -98,7 +106,7 @@ def _run_contact_geometry(ctx):
     f1, ax = _fig()
     ax = ax[0, 0]
     ax.plot(ys, table["delta_r [mm]"], lw=1.2)
-    ax.axvline(y_f * 1e3, ls=":", c="k", lw=0.8, label=f"flange contact from {y_f * 1e3:.2f} mm")
+    ax.axvline(y_f * 1e3, ls=":", c="k", lw=0.8, label=f"flange contact from {y_f * 1e3:.4f} mm")
     ax.set(xlabel="lateral shift y [mm]", ylabel=r"$\Delta r = r_L - r_R$ [mm]",
            title=f"contact geometry — rolling-radius difference\n{setting}")
     ax.title.set_fontsize(9)
@@ -127,15 +135,18 @@ def _run_contact_geometry(ctx):
     notes = (
         f"Rigid (zero-penetration) contact of new S1002 wheels (r0 = 460 mm) on UIC60 rails "
         f"inclined 1:40, gauge 1435 mm (14 mm below the top), flange-back spacing 1360 mm, "
-        f"{n} lateral shifts over +-10 mm. Flange contact starts at {y_f * 1e3:.2f} mm with a "
-        f"contact angle of {np.degrees(g_f):.1f} deg; equivalent conicity (EN 15302, exact "
+        f"{n} lateral shifts over +-10 mm. Flange contact starts at {y_f * 1e3:.4f} mm (located "
+        f"between the table's rows by bisection to 0.1 um) with a contact angle of "
+        f"{np.degrees(g_f):.2f} deg; equivalent conicity (EN 15302, exact "
         f"kinematic wavelength) {con['conicity wavelength [-]'].iloc[0]:.3f} / "
         f"{con['conicity wavelength [-]'].iloc[1]:.3f} / {con['conicity wavelength [-]'].iloc[2]:.3f}"
         f" at 2 / 3 / 4 mm. The contact point jumps across the S1002 tread (near-equal minima of "
-        f"the gap), hence the steps in the contact positions. Tables in mm, deg (contact angles) "
+        f"the gap), hence the steps in the contact positions; table 'transitions' gives every "
+        f"jump, located by bisection. Tables in mm, deg (contact angles) "
         f"and mrad (roll, yaw).\n\n" + _REF_GEOMETRY)
     return dict(tables={"contact_geometry": table, "excerpt": excerpt, "summary": summary,
-                        "equivalent_conicity": _display_units(con)},
+                        "equivalent_conicity": _display_units(con),
+                        "transitions": _display_units(trans)},
                 figures={"delta_r": f1, "contact_angle": f2, "contact_positions": f3}, notes=notes)
 
 

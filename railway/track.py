@@ -72,6 +72,7 @@ from core.curves import (
     TabulatedFramedCurve,
     quintic_hermite_coeffs,
 )
+from core.errors import InputError
 
 from .profiles import RailProfile
 
@@ -127,17 +128,17 @@ class Irregularities:
         self.vertical = np.asarray(self.vertical, dtype=float)
         for name, a in (("s", self.s), ("lateral", self.lateral), ("vertical", self.vertical)):
             if a.ndim != 1 or a.size != self.s.size:
-                raise ValueError(f"irregularities: column {name} must be 1-D of length {self.s.size}")
+                raise InputError(f"irregularities: column {name} must be 1-D of length {self.s.size}")
             bad = ~np.isfinite(a)
             if np.any(bad):
                 i = int(np.argmax(bad))
-                raise ValueError(f"irregularities: {name}[{i}] = {a[i]!r} is not finite")
+                raise InputError(f"irregularities: {name}[{i}] = {a[i]!r} is not finite")
         if self.s.size < 4:
-            raise ValueError("irregularities: at least 4 rows are needed")
+            raise InputError("irregularities: at least 4 rows are needed")
         d = np.diff(self.s)
         if np.any(d <= 0):
             i = int(np.argmax(d <= 0)) + 1
-            raise ValueError(f"irregularities: s must increase strictly; s[{i}] = {self.s[i]!r}")
+            raise InputError(f"irregularities: s must increase strictly; s[{i}] = {self.s[i]!r}")
 
     @classmethod
     def from_csv(cls, path):
@@ -153,7 +154,7 @@ class Irregularities:
                 key = f"{base} {unit}"
                 if key in cols:
                     return df[cols[key]].to_numpy(float) * f
-            raise ValueError(f"{path}: missing column '{base} [m]' (or [mm]); found {list(df.columns)}")
+            raise InputError(f"{path}: missing column '{base} [m]' (or [mm]); found {list(df.columns)}")
 
         return cls(col("s"), col("lateral"), col("vertical"))
 
@@ -240,17 +241,17 @@ class Track(FramedCurve):
                  origin=(0.0, 0.0, 0.0), heading=0.0):
         segments = list(segments)
         if not segments:
-            raise ValueError("track: at least one segment is needed")
+            raise InputError("track: at least one segment is needed")
         for i, seg in enumerate(segments):
             if not isinstance(seg, (Straight, Curve, Transition)):
-                raise ValueError(f"track: segment {i} is {seg!r}, not Straight/Curve/Transition")
+                raise InputError(f"track: segment {i} is {seg!r}, not Straight/Curve/Transition")
             if not (np.isfinite(seg.length) and seg.length > 0):
-                raise ValueError(f"track: segment {i} length {seg.length!r} must be positive")
+                raise InputError(f"track: segment {i} length {seg.length!r} must be positive")
             if isinstance(seg, Curve):
                 if not (np.isfinite(seg.radius) and seg.radius != 0):
-                    raise ValueError(f"track: segment {i} radius {seg.radius!r} must be finite, non-zero")
+                    raise InputError(f"track: segment {i} radius {seg.radius!r} must be finite, non-zero")
                 if not (np.isfinite(seg.cant) and 0.0 <= seg.cant < cant_base):
-                    raise ValueError(f"track: segment {i} cant {seg.cant!r} m must be in [0, {cant_base})")
+                    raise InputError(f"track: segment {i} cant {seg.cant!r} m must be in [0, {cant_base})")
         self.segments = segments
         self.cant_base = float(cant_base)
         self.irregularities = irregularities
@@ -447,24 +448,29 @@ def parse_inclination(value):
             try:
                 value = float(num) / float(den)
             except (ValueError, ZeroDivisionError):
-                raise ValueError(f"rail inclination {value!r}: expected e.g. '1:40'") from None
+                raise InputError(f"rail inclination {value!r}: expected e.g. '1:40'") from None
         else:
             try:
                 value = float(v)
             except ValueError:
-                raise ValueError(f"rail inclination {value!r}: expected e.g. '1:40', 0.025 or 'vertical'") from None
+                raise InputError(f"rail inclination {value!r}: expected e.g. '1:40', 0.025 or 'vertical'") from None
     value = float(value)
     if not np.isfinite(value):
-        raise ValueError(f"rail inclination {value!r} is not finite")
+        raise InputError(f"rail inclination {value!r} is not finite")
     if value < 0.0:
-        raise ValueError(
+        raise InputError(
             f"rail inclination {value!r}"
             + (f" (given as {given!r})" if isinstance(given, str) else "")
             + " is negative: rails are inclined towards the track "
-            f"centre, give tan(alpha) >= 0 (e.g. 1/40 = 0.025)")
+            "centre, give tan(alpha) >= 0 (e.g. 1/40 = 0.025)")
     if value > 0.2:
-        raise ValueError(f"rail inclination {value!r} is implausibly large (tan alpha > 0.2)")
+        raise InputError(f"rail inclination {value!r} is implausibly large (tan alpha > 0.2)")
     return value
+
+
+#: Plausible track gauges (m): from 15-inch minimum gauge (0.381 m) to Indian broad gauge
+#: (1.676 m), with margin; a value outside is taken for a unit slip.
+GAUGE_RANGE = (0.3, 2.0)
 
 
 class RailMounting:
@@ -495,7 +501,15 @@ class RailMounting:
         self.profile = profile if profile is not None else RailProfile.uic60()
         for key, val in (("gauge", gauge), ("gauge_depth", gauge_depth)):
             if not np.isfinite(val) or val <= 0:
-                raise ValueError(f"rail mounting: {key} = {val!r} must be positive and finite")
+                raise InputError(f"rail mounting: {key} = {val!r} must be positive and finite")
+        if not (GAUGE_RANGE[0] <= gauge <= GAUGE_RANGE[1]):
+            raise InputError(
+                f"rail mounting: gauge = {gauge!r} m is implausible (expected {GAUGE_RANGE[0]:g} to "
+                f"{GAUGE_RANGE[1]:g} m, e.g. 1.435); the gauge is in metres"
+                + (" -- was it given in millimetres?" if gauge > GAUGE_RANGE[1] else ""))
+        if not (0.0 < gauge_depth < 0.05):
+            raise InputError(f"rail mounting: gauge_depth = {gauge_depth!r} m is implausible (expected "
+                             "below 0.05 m, e.g. 0.014); it is in metres")
         self.gauge = float(gauge)
         self.inclination = parse_inclination(inclination)
         self.gauge_depth = float(gauge_depth)
@@ -514,7 +528,6 @@ class RailMounting:
         while hi < u.size - 1 and ok[hi + 1]:
             hi += 1
         self.u_min, self.u_max = float(u[lo]), float(u[hi])
-        Yo = u * self.ca - v * self.sa
         Z = u * self.sa + v * self.ca
         i_top = int(np.argmax(Z))
         # refine the top (dZ/du = 0) and the gauge point (Z = Z_top - depth on the gauge side)
@@ -524,7 +537,7 @@ class RailMounting:
         m = (u < ut) & (u >= self.u_min)
         j = np.nonzero(m & (Z <= target))[0]
         if j.size == 0:
-            raise ValueError(f"rail mounting: the profile {p.name} does not reach {gauge_depth} m "
+            raise InputError(f"rail mounting: the profile {p.name} does not reach {gauge_depth} m "
                              f"below its top on the gauge side")
         ug0 = u[j[-1]]
         ug = self._newton(ug0, lambda x: self._mounted(x)[1] - target,

@@ -151,6 +151,10 @@ def run_contact_table(args) -> int:
     if not (args.y_max_mm > 0):
         raise InputError(f"--y-max-mm {args.y_max_mm!r} must be positive")
     _check_mm_options(args)
+    if args.out:  # a path that is a file is refused before the computation, not after it
+        from core.paths import output_folder
+
+        output_folder(args.out)
     try:
         amps = np.array([float(a) for a in args.amplitudes_mm.split(",")]) * 1e-3
     except ValueError:

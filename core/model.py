@@ -327,6 +327,53 @@ class ModelBuilder:
         return self.add_force(Bushing(name, body_i, body_j, at, translational_stiffness, rotational_stiffness,
                                       translational_damping, rotational_damping, axes, point_j))
 
+    def add_bump_stop(self, name, body_i, body_j, at, axis, table, damping=0.0, sides="both", point_j=None):
+        """Clearance spring along a body-fixed axis with a tabulated force law (:class:`core.forces.BumpStop`).
+
+        ``table`` rows are (total relative displacement [m], force [N]); the first row is the
+        clearance with force 0.
+        """
+        from .forces import BumpStop
+
+        return self.add_force(BumpStop(name, body_i, body_j, at, axis, table, damping, sides, point_j))
+
+    def add_series_spring_damper(self, name, body_i, body_j, point_i, point_j, stiffness, damping, node_mass,
+                                 free_length=None, node_position=None):
+        """Spring in series with a damper (Maxwell element, :class:`core.forces.SeriesSpringDamper`).
+
+        Adds the extra coordinate ``f"{name}.node"`` (the node position x along PQ from P [m],
+        initially ``node_position``, default half the distance PQ) with mass ``node_mass`` [kg]
+        (> 0: the damper's moving mass), then the element.  The node makes the model stiff
+        (eigenvalue ≈ −c/m_n): integrate with ``jit-radau`` or another implicit method.
+        """
+        from .forces import SeriesSpringDamper
+
+        self._check_new(name, "force element")
+        try:
+            m_n = float(node_mass)
+        except (TypeError, ValueError):
+            m_n = float("nan")
+        if not (np.isfinite(m_n) and m_n > 0):
+            raise ModelError(f"series spring-damper {name!r}: node mass must be a finite number > 0 [kg] (the "
+                             f"damper's moving mass; a massless node is not supported by core), got {node_mass!r}")
+        if node_position is None:
+            try:
+                x0 = 0.5 * float(np.linalg.norm(np.asarray(point_j, float) - np.asarray(point_i, float)))
+            except (TypeError, ValueError):
+                x0 = 0.0
+            x0 = x0 if np.isfinite(x0) else 0.0  # the element reports bad points at build
+        else:
+            try:
+                x0 = float(node_position)
+            except (TypeError, ValueError):
+                x0 = float("nan")
+        if not np.isfinite(x0):
+            raise ModelError(f"series spring-damper {name!r}: node position must be a finite number [m], "
+                             f"got {node_position!r}")
+        node = self.add_coordinate(f"{name}.node", x0, 0.0, m_n)
+        return self.add_force(SeriesSpringDamper(name, body_i, body_j, point_i, point_j, stiffness, damping, node,
+                                                 free_length))
+
     def add_applied_force(self, name, body, point, force, frame="global"):
         """Force of time at a body point (:class:`core.forces.AppliedForce`)."""
         from .forces import AppliedForce

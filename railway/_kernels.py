@@ -23,7 +23,10 @@ except ImportError:  # pragma: no cover - exercised only without numba
 __all__ = ["HAVE_NUMBA", "newton_kernel", "scan_kernel"]
 
 
-def _define():
+# The kernels are module-level functions (inside this ``if``), not closures: numba's on-disk
+# cache can index a module-level function that calls others by their global names, while
+# closures built by a factory got a new cache entry (and a recompilation) in every process.
+if HAVE_NUMBA:
     njit = numba.njit(cache=True, fastmath=False)
 
     @njit
@@ -287,11 +290,6 @@ def _define():
                 V[pi, 0, k] = p[k]; V[pi, 1, k] = q[k]; V[pi, 2, k] = n[k]
         return X, H0, conv, max_it, GAP, S, V
 
-    return newton
-
-
-def _define_scan():
-    njit = numba.njit(cache=True, fastmath=False)
 
     @njit
     def scan(r, ax, d, pos, tan, lat, up, sig, L, yg, rg, F1g, side_left, b0, u0, Y0, Z0,
@@ -360,28 +358,13 @@ def _define_scan():
                 out[rank, p, 5] = yg[p, max(jj - 1, 0)]
                 out[rank, p, 6] = yg[p, min(jj + 2, G - 1)]
 
-    return scan
-
-
-_NEWTON = None
-_SCAN = None
 
 
 def scan_kernel():
     """The compiled seed scan (compiled on first use), or None without numba."""
-    global _SCAN
-    if not HAVE_NUMBA:
-        return None
-    if _SCAN is None:
-        _SCAN = _define_scan()
-    return _SCAN
+    return scan if HAVE_NUMBA else None
 
 
 def newton_kernel():
     """The compiled Newton kernel (compiled on first use), or None without numba."""
-    global _NEWTON
-    if not HAVE_NUMBA:
-        return None
-    if _NEWTON is None:
-        _NEWTON = _define()
-    return _NEWTON
+    return newton if HAVE_NUMBA else None

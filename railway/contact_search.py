@@ -906,12 +906,14 @@ class ContactSearch:
         ok = conv & inside & (g > -self.max_penetration)
         return ok, np.where(ok, g, np.inf)
 
-    def _multistart(self, x0, pc, rP, AP, store, it0, max_iter=None, scan_out=None):
+    def _multistart(self, x0, pc, rP, AP, store, it0, max_iter=None, scan_out=None,
+                    return_all=False):
         """Newton from several seeds per problem side by side; keep the lowest valid gap.
 
         With ``scan_out`` (the bracketed scan seeds), scan seeds at a stationary point that
         Newton did not solve are handed to :meth:`_rescue`; its result replaces the Newton
-        result where its gap is lower.
+        result where its gap is lower.  With ``return_all`` the Newton solutions of every seed
+        (m, P, 4) and their gaps (m, P) (+inf where invalid) are returned as well.
         """
         P = rP.shape[0]
         m = x0.shape[0] // P
@@ -920,6 +922,7 @@ class ContactSearch:
                                              np.concatenate([AP] * m), max_iter=max_iter)
         _, g = self._valid_gap(x, conv, info, pcm)
         g = g.reshape(m, P)
+        x_all, g_all = x.reshape(m, P, 4).copy(), g.copy()
         # seeds that Newton did not solve (converged inside the zones; a solved seed may still
         # be invalid by a too deep penetration, which no second attempt changes)
         solved = (conv & np.all((x > pcm["lo_e"]) & (x < pcm["hi_e"]), axis=1)).reshape(m, P)
@@ -954,7 +957,102 @@ class ContactSearch:
         if store:
             self._x_prev, self._x = None, x
             self._valid_prev = res.valid.ravel()
+        if return_all:
+            return res, x_all, g_all, x
         return res
+
+    # ------------------------------------------------------------------------------------
+    # stateless interface: for a force element whose search state is frozen between the
+    # accepted steps of an integrator (railway.wheel_rail), nothing here reads or changes the
+    # warm start of :meth:`search`
+    def scan_seeds(self, r_ws, A, s_ws, ranks=None):
+        """Seeds of the global cross-section scan at the given poses (no state is used or kept).
+
+        Returns a list of ``ranks`` (default ``n_seeds``) arrays (P, 7): the seed (theta, y, s,
+        u), a flag (1.0 where a stationary point lies near) and its bracket in y (see
+        :meth:`_seed_scan`); P = 4 n_wheelsets problems, ordered wheelset, side, candidate.
+        """
+        r_ws, A, s_ws = self._check_pose(r_ws, A, s_ws, self.n_wheelsets)
+        return self._seed_scan(self._problems, r_ws, A, s_ws, brackets=True,
+                               ranks=ranks or self.n_seeds)
+
+    def solve(self, seeds, r_ws, A, s_ws, scan_out=None, max_iter=None):
+        """Contacts from explicit seeds, without any state (a pure function of its arguments).
+
+        Newton runs from every seed of every problem side by side; per problem the lowest valid
+        gap wins (ties: the first seed).  ``scan_out`` (from :meth:`scan_seeds`, whose seeds
+        must be the last ones of ``seeds``) lets seeds that Newton cannot solve be refined by
+        the robust route (:meth:`_robust`).
+
+        Parameters
+        ----------
+        seeds : sequence of (P, 4) arrays
+        r_ws, A, s_ws : see :meth:`search`
+
+        Returns
+        -------
+        res : ContactResult
+        x_all : (m, P, 4) ndarray
+            Newton solution from every seed (before the robust route).
+        g_all : (m, P) ndarray
+            Their gaps (m), +inf where invalid.
+        x_best : (P, 4) ndarray
+            The parameters of ``res``.
+        """
+        r_ws, A, s_ws = self._check_pose(r_ws, A, s_ws, self.n_wheelsets)
+        pc = self._problems
+        ws = pc["ws"]
+        x0 = np.concatenate([np.asarray(q, dtype=float)[:, :4] for q in seeds])
+        return self._multistart(x0, pc, r_ws[ws], A[ws], False, 0, max_iter=max_iter,
+                                scan_out=scan_out, return_all=True)
+
+    def solve_pairs(self, x0, problem, r_ws, A, s_ws):
+        """Contacts from explicit (seed, problem) pairs, without any state.
+
+        Newton runs from every seed ``x0[k]`` (K, 4) for the problem ``problem[k]`` (an index
+        into the P = 4 n_wheelsets problems; a problem may have several seeds or none); per
+        problem the lowest valid gap wins (ties: the first pair).  Problems without a pair, or
+        whose pairs all fail, have no contact (``valid`` False).  Cheaper than :meth:`solve` on
+        trajectories, where only the candidates that had a contact at the last accepted step
+        need iterating (no robust refinement here: that is :meth:`solve` with scan seeds).
+
+        Returns
+        -------
+        res : ContactResult
+        x_pairs : (K, 4) ndarray
+            Newton solution of every pair.
+        g_pairs : (K,) ndarray
+            Their gaps (m), +inf where invalid.
+        """
+        r_ws, A, s_ws = self._check_pose(r_ws, A, s_ws, self.n_wheelsets)
+        pc = self._problems
+        ws = pc["ws"]
+        P = ws.size
+        problem = np.asarray(problem, dtype=np.int64)
+        x0 = np.asarray(x0, dtype=float).reshape(-1, 4)
+        if problem.size:
+            pck = {k: (v[problem] if isinstance(v, np.ndarray) else v) for k, v in pc.items()}
+            xk, Hk, ck, it, infk = self._newton(x0, pck, r_ws[ws[problem]], A[ws[problem]])
+            _, gk = self._valid_gap(xk, ck, infk, pck)
+            gsv = self._gsv(xk, pck, infk)
+        else:
+            xk, Hk, ck, it, gk = x0.copy(), np.zeros((0, 4)), np.zeros(0, bool), 0, np.zeros(0)
+            gsv = dict(gap=np.zeros(0), S=np.zeros((0, 11)), V=np.zeros((0, 3, 3)))
+        # per problem: the pair with the lowest valid gap (the first one on ties)
+        x = np.full((P, 4), np.nan)
+        H0 = np.full((P, 4), np.inf)
+        conv = np.zeros(P, dtype=bool)
+        info = dict(gap=np.full(P, np.inf), S=np.full((P, 11), np.nan), V=np.full((P, 3, 3), np.nan))
+        if problem.size:
+            order = np.lexsort((np.arange(problem.size), gk, problem))  # problem, gap, pair
+            first = order[np.r_[True, problem[order][1:] != problem[order][:-1]]]
+            p = problem[first]
+            x[p], H0[p], conv[p] = xk[first], Hk[first], ck[first] & np.isfinite(gk[first])
+            for key in info:
+                info[key][p] = gsv[key][first]
+        x = np.where(np.isnan(x), pc["lo"].clip(-1.0, 1.0), x)  # placeholders of problems without pairs
+        res = self._finish(x, H0, conv, pc, info, it)
+        return res, xk, gk
 
     def _gsv(self, x, pc, info):
         """Outputs in the compiled kernel's form dict(gap, S, V) (copies)."""

@@ -87,6 +87,7 @@ __all__ = [
     "kalker_coefficients",
     "kalker_table",
     "kalker_table_path",
+    "polach2005_parameter_sets",
 ]
 
 _KALKER_FILE = ("railway", "kalker_coefficients.csv")
@@ -577,8 +578,9 @@ class Polach2005(CreepModel):
     spin term is not reduced by k_A, k_S).  Small creepage: Fx -> (k_A + k_S)/2 * (-G c^2 C11 xi).
     Large creepage: |F| -> mu(w) N.  The ``mu`` argument of the call is mu0.
 
-    Defaults k_A = k_S = 1, A = 1, B = 0 reduce the law to :class:`Polach2000`; published parameter
-    sets (dry/wet) must be taken from Polach (2005), Table 2, after checking them there; the notes
+    Defaults k_A = k_S = 1, A = 1, B = 0 reduce the law to :class:`Polach2000`.  The dry and wet
+    sets of Polach (2005), Table 2, as quoted second-hand (not checked against the paper), are
+    data: :meth:`from_parameter_set` ("dry", "wet"), :func:`polach2005_parameter_sets`.  The notes
     quote mu0 = 0.36, A = 0.38, B = 0.7 s/m for a locomotive (Spiryagin, Polach & Cole 2013).
 
     Parameters
@@ -610,6 +612,45 @@ class Polach2005(CreepModel):
             raise InputError(f"Polach 2005 speed must be > 0 m/s, got {speed!r}")
         self.k_A, self.k_S, self.A, self.B, self.speed, self.join = k_A, k_S, A, B, speed, join
 
+    @classmethod
+    def from_parameter_set(cls, name: str, speed: float = 20.0, join: str = "scaled") -> "Polach2005":
+        """The law with a published parameter set (k_A, k_S, A, B) by name.
+
+        The sets are data (``data/railway/polach2005_parameters.csv``, see
+        :func:`polach2005_parameter_sets`): "dry" (k_A = 1.0, k_S = 0.4, A = 0.4, B = 0.6 s/m)
+        and "wet" (k_A = 0.3, k_S = 0.1, A = 0.4, B = 0.2 s/m), quoted second-hand as Polach
+        (2005), Wear 258, Table 2, and *not checked against the paper*.  The friction
+        coefficient mu0 is the caller's (the ``mu`` of the call); the file's inferred mu0 is
+        not used.
+
+        Parameters
+        ----------
+        name : {"dry", "wet"}
+            Parameter set (case-insensitive).
+        speed : float
+            Rolling speed V (m/s) for the slip velocity w = V |(xi, eta)|.
+        join : {"scaled", "raw"}
+
+        Returns
+        -------
+        Polach2005
+
+        Raises
+        ------
+        core.errors.UnknownNameError
+            An unknown set (lists the sets of the file).
+        core.errors.InputError
+            A speed <= 0.
+        """
+        sets = polach2005_parameter_sets()
+        key = str(name).strip().lower()
+        if key not in set(sets["set"]):
+            raise UnknownNameError(f"Polach 2005 parameter set {name!r} is unknown; the sets of "
+                                   f"{_POLACH2005_FILE[-1]} are {sorted(sets['set'])}")
+        row = sets[sets["set"] == key].iloc[0]
+        return cls(k_A=float(row["k_A [-]"]), k_S=float(row["k_S [-]"]), A=float(row["A [-]"]),
+                   B=float(row["B [s/m]"]), speed=speed, join=join)
+
     def friction(self, mu0, xi, eta):
         """mu(w) = mu0 [(1 - A) exp(-B w) + A], w = V |(xi, eta)| (arrays broadcast)."""
         w = self.speed * np.hypot(xi, eta)
@@ -620,6 +661,42 @@ class Polach2005(CreepModel):
         muw = self.friction(mu, xi, eta)
         Fx, Fy, FyS = _polach(xi, eta, phi, N, a, b, G, muw, C11, C22, C23, kA=self.k_A, kS=self.k_S)
         return Fx, Fy + FyS, Mzl * _she_factor(Fxl, Fyl, muw, N)
+
+
+_POLACH2005_FILE = ("railway", "polach2005_parameters.csv")
+
+
+def polach2005_parameter_sets() -> pd.DataFrame:
+    """Published Polach (2005) parameter sets, read from ``data/railway/polach2005_parameters.csv``.
+
+    Returns
+    -------
+    DataFrame
+        One row per set (``set`` = "dry", "wet"), columns ``k_A [-]``, ``k_S [-]``, ``A [-]``,
+        ``B [s/m]``, ``mu0 (inferred) [-]``, ``source`` and ``status``.  Every row is flagged
+        "second-hand, not checked against the paper" (Polach 2005, Wear 258, Table 2, quoted by
+        a third party); mu0 is an inference from a third-party interpolation, not a quoted value
+        (see the file's header).
+
+    Raises
+    ------
+    core.errors.DataFileError
+        Missing columns, or values outside 0 < k_S <= k_A <= 1, 0 < A <= 1, B >= 0 (names the
+        file and the row).
+    """
+    from core.paths import data_path
+
+    path = data_path(*_POLACH2005_FILE)
+    df = pd.read_csv(path, comment="#")
+    need = {"set", "k_A [-]", "k_S [-]", "A [-]", "B [s/m]", "source", "status"}
+    if not need <= set(df.columns):
+        raise DataFileError(f"{path}: missing columns {sorted(need - set(df.columns))}")
+    df["set"] = df["set"].str.strip().str.lower()
+    for _, r in df.iterrows():
+        if not (0.0 < r["k_S [-]"] <= r["k_A [-]"] <= 1.0 and 0.0 < r["A [-]"] <= 1.0 and r["B [s/m]"] >= 0.0):
+            raise DataFileError(f"{path}: set {r['set']!r} has parameters out of range "
+                                f"(k_A={r['k_A [-]']}, k_S={r['k_S [-]']}, A={r['A [-]']}, B={r['B [s/m]']})")
+    return df
 
 
 @register_creep_model("fastsim")

@@ -67,7 +67,7 @@ from core.contact_laws import (
 )
 from core.errors import InputError
 
-from .creep import CreepModel, KalkerLinear, Polach2000, get_creep_model, kalker_coefficients
+from .creep import CreepForces, CreepModel, KalkerLinear, Polach2000, get_creep_model, kalker_coefficients
 
 __all__ = ["ContactForces", "FORCE_KEYS", "lankarani_nikravesh_force", "wheel_rail_curvatures"]
 
@@ -76,15 +76,32 @@ FORCE_KEYS = ("N", "Fx", "Fy", "Mz", "xi", "eta", "phi", "a", "b", "delta_dot")
 _RHO_MAX = 1e3
 
 
-def _kernel_code(law: CreepModel) -> int | None:
-    """Code of ``law`` in the compiled kernel (0 Kalker linear, 1 Polach 2000) or None.
+def _kernel_code(law: CreepModel | None):
+    """(code, parameters) of ``law`` in the compiled kernel, or None.
 
-    Only the exact classes with the tables the kernel is built from (``join="scaled"``) qualify;
-    subclasses and other joins run on the reference path.
+    Codes: -1 normal forces only (``law`` None), 0 Kalker linear, 1 Polach 2000, 2
+    Shen–Hedrick–Elkins, 3 Polach 2005 (parameters k_A, k_S, A, B, speed), 4 FASTSIM
+    (parameters n_x, n_y).  Only the exact classes with the tables the kernel is built from
+    (``join="scaled"``) qualify; subclasses, user laws and other joins run on the reference path.
     """
+    from .creep import Fastsim, Polach2005, ShenHedrickElkins
+
+    if law is None:
+        return -1, np.zeros(5)
     if getattr(law, "join", None) != "scaled":
         return None
-    return {KalkerLinear: 0, Polach2000: 1}.get(type(law))
+    t = type(law)
+    if t is KalkerLinear:
+        return 0, np.zeros(5)
+    if t is Polach2000:
+        return 1, np.zeros(5)
+    if t is ShenHedrickElkins:
+        return 2, np.zeros(5)
+    if t is Polach2005:
+        return 3, np.array([law.k_A, law.k_S, law.A, law.B, law.speed], float)
+    if t is Fastsim:
+        return 4, np.array([law.n_x, law.n_y, 0.0, 0.0, 0.0], float)
+    return None
 
 
 def wheel_rail_curvatures(R_wheel_rolling, R_wheel_lateral, R_rail_lateral, R_rail_rolling=np.inf):
@@ -182,10 +199,13 @@ def lankarani_nikravesh_force(penetration, penetration_rate, stiffness, restitut
                             np.atleast_1d(stiffness), chi, v0, 1.5).force
 
 
-def _define_kernel():
-    import numba
+try:  # optional dependency; module-level kernels so that numba's disk cache finds them
+    import numba as _numba
+except ImportError:  # pragma: no cover - numba missing
+    _numba = None
 
-    @numba.njit(cache=True)
+if _numba is not None:
+    @_numba.njit(cache=True)
     def normal_law(Kh, d, dd, chi, v0):
         """Eq. (N1) of :mod:`core.contact_laws` with p = 3/2, for numba (one contact).
 
@@ -197,15 +217,115 @@ def _define_kernel():
         F = Kh * d**1.5 * (1.0 + chi * dd / v0)
         return F if F > 0.0 else 0.0
 
-    @numba.njit(cache=True)
+    @_numba.njit(cache=True)
+    def she_factor(Fxl, Fyl, mu, N):
+        """Shen–Hedrick–Elkins factor F_R'/F_R of the linear resultant (railway.creep._she_factor)."""
+        beta = np.sqrt(Fxl * Fxl + Fyl * Fyl) / (mu * N)
+        return 1.0 - beta / 3.0 + beta * beta / 27.0 if beta < 3.0 else 1.0 / beta
+
+    @_numba.njit(cache=True)
+    def polach(xi, eta, phi, N, a, b, G, mu, C11, C22, C23, kA, kS):
+        """Polach's method (railway.creep._polach): Fx and Fy including the spin part."""
+        s = np.sqrt(xi * xi + eta * eta)
+        sys_ = eta + phi * a
+        syC = sys_ if abs(sys_) > abs(eta) else eta
+        sC = np.sqrt(xi * xi + syC * syC)
+        if not (sC > 0.0):
+            return 0.0, 0.0
+        if s > 0.0:
+            cjj = np.sqrt((C11 * xi / s) ** 2 + (C22 * eta / s) ** 2)
+        else:
+            cjj = C22
+        eps = np.pi * G * a * b * cjj * sC / (4.0 * N * mu)
+        F = 2.0 * N * mu / np.pi * (kA * eps / (1.0 + (kA * eps) ** 2) + np.arctan(kS * eps))
+        Fx = -F * xi / sC
+        Fy = -F * eta / sC
+        KS = 1.0 + 6.3 * (1.0 - np.exp(-a / b))
+        epsM = 8.0 / 3.0 * G * b * np.sqrt(a * b) / (N * mu) * C23 * abs(syC) / KS
+        dl = (epsM * epsM - 1.0) / (epsM * epsM + 1.0)
+        q = 1.0 - dl * dl
+        if q < 0.0:
+            q = 0.0
+        KM = abs(epsM) * (dl**3 / 3.0 - dl * dl / 2.0 + 1.0 / 6.0) - np.sqrt(q**3) / 3.0
+        Fy += 9.0 / 16.0 * a * mu * N * KM * KS * phi / sC
+        return Fx, Fy
+
+    @_numba.njit(cache=True)
+    def fastsim(xi, eta, phi, N, a, b, G, mu, C11, C22, C23, nx, ny):
+        """FASTSIM strip marching (railway.creep.Fastsim), one contact."""
+        L1 = 8.0 * a / (3.0 * G * C11)
+        L2 = 8.0 * a / (3.0 * G * C22)
+        L3 = np.pi * a * np.sqrt(a / b) / (4.0 * G * C23)
+        dy = 2.0 * b / ny
+        pmax_c = 2.0 * N / (np.pi * a * b)
+        Fx = 0.0
+        Fy = 0.0
+        Mz = 0.0
+        for j in range(ny):
+            yb = (j + 0.5) / ny * 2.0 - 1.0
+            y = b * yb
+            aj = a * np.sqrt(1.0 - yb * yb)
+            dx = 2.0 * aj / nx
+            ax = xi / L1 - phi / L3 * y
+            ay = eta / L2
+            sp = phi / L3
+            px = 0.0
+            py = 0.0
+            for i in range(nx):
+                x_c = aj - (i + 0.5) * dx
+                x_b = aj - i * dx
+                h = 0.5 * dx if i == 0 else dx
+                x_mid = x_b - 0.25 * dx if i == 0 else x_b
+                px -= ax * h
+                py -= (ay + sp * x_mid) * h
+                bnd = 1.0 - (x_c / a) ** 2 - yb * yb
+                bound = mu * pmax_c * (bnd if bnd > 0.0 else 0.0)
+                mag = np.sqrt(px * px + py * py)
+                if mag > bound:
+                    fac = bound / mag
+                    px *= fac
+                    py *= fac
+                w = dx * dy
+                Fx += px * w
+                Fy += py * w
+                Mz += (x_c * py - y * px) * w
+        return Fx, Fy, Mz
+
+    @_numba.njit(cache=True)
+    def creep_law(model, cp, xi, eta, phi, N, a, b, G, mu, C11, C22, C23, C33):
+        """Forces (Fx, Fy, Mz) on the wheel of the creep law ``model`` (see _kernel_code)."""
+        c2 = a * b
+        cc = np.sqrt(c2)
+        Fxl = -G * c2 * C11 * xi
+        Fyl = -G * c2 * C22 * eta - G * c2 * cc * C23 * phi
+        Mzl = G * c2 * cc * C23 * eta - G * c2 * c2 * C33 * phi
+        if model == 0:
+            return Fxl, Fyl, Mzl
+        if model == 2:
+            fac = she_factor(Fxl, Fyl, mu, N)
+            return Fxl * fac, Fyl * fac, Mzl * fac
+        if model == 4:
+            return fastsim(xi, eta, phi, N, a, b, G, mu, C11, C22, C23, int(cp[0]), int(cp[1]))
+        kA, kS, muw = 1.0, 1.0, mu
+        if model == 3:
+            kA, kS = cp[0], cp[1]
+            w = cp[4] * np.sqrt(xi * xi + eta * eta)
+            muw = mu * ((1.0 - cp[2]) * np.exp(-cp[3] * w) + cp[2])
+        Fx, Fy = polach(xi, eta, phi, N, a, b, G, muw, C11, C22, C23, kA, kS)
+        return Fx, Fy, Mzl * she_factor(Fxl, Fyl, muw, N)
+
+    @_numba.njit(cache=True)
     def kernel(pen, valid, kwr, kwl, krr, krl, P, Nrm, ws_of, rws, vws, wws, fwd,
-               t0, dt, tab, ksum, G, mu, chi, v0, model, out, Fg, Mg):
+               t0, dt, tab, ksum, G, mu, chi, v0, model, cp, out, Fg, Mg):
         """All contacts in one loop: Hertz (Eqs. H1-H6 of :mod:`core.contact_laws`, coefficients
         from ``tab``), the normal law N1 (:func:`normal_law`), creepages and the creep law
-        ``model`` (0 Kalker linear, 1 Polach 2000, as :mod:`railway.creep`).  See the module
-        docstring; the definitions are those modules, this is their compiled copy."""
+        ``model`` with parameters ``cp`` (:func:`_kernel_code`; -1: normal forces only).  See the
+        module docstring; the definitions are those modules, this is their compiled copy.
+        Returns the smallest rolling speed of a loaded contact (inf without one; creep laws need
+        it above 1e-3 m/s, the caller checks)."""
         nt = tab.shape[1]
         vmin = np.inf
+        c = np.empty(tab.shape[0])
         for i in range(pen.shape[0]):
             for k in range(out.shape[1]):
                 out[i, k] = 0.0
@@ -229,7 +349,6 @@ def _define_kernel():
             if j < 0:
                 j = 0
             w = x - j
-            c = np.empty(tab.shape[0])
             for k in range(tab.shape[0]):
                 c[k] = (1.0 - w) * tab[k, j] + w * tab[k, j + 1]
             mH, nH, Kel, C11, C22, C23, C33 = c[0], c[1], c[2], c[3], c[4], c[5], c[6]
@@ -263,52 +382,20 @@ def _define_kernel():
             lx = n1 * tz - n2 * ty
             ly = n2 * tx - n0 * tz
             lz = n0 * ty - n1 * tx
-            V = abs(vws[iw, 0] * tx + vws[iw, 1] * ty + vws[iw, 2] * tz)
-            if V < vmin:
-                vmin = V
-            if V < 1e-3:
-                continue
             dd = -(vx * n0 + vy * n1 + vz * n2)
             N = normal_law(Kh, d, dd, chi, v0)
-            xi = (vx * tx + vy * ty + vz * tz) / V
-            eta = (vx * lx + vy * ly + vz * lz) / V
-            phi = (wx * n0 + wy * n1 + wz * n2) / V
-            c2 = a * b
-            cc = np.sqrt(c2)
-            Fxl = -G * c2 * C11 * xi
-            Fyl = -G * c2 * C22 * eta - G * c2 * cc * C23 * phi
-            Mzl = G * c2 * cc * C23 * eta - G * c2 * c2 * C33 * phi
-            if model == 0 or N <= 0.0:
-                Fx, Fy, Mz = Fxl, Fyl, Mzl
-                if N <= 0.0:
-                    Fx, Fy, Mz = 0.0, 0.0, 0.0
-            else:
-                s = np.sqrt(xi * xi + eta * eta)
-                sys_ = eta + phi * a
-                syC = sys_ if abs(sys_) > abs(eta) else eta
-                sC = np.sqrt(xi * xi + syC * syC)
-                Fx = 0.0
-                Fy = 0.0
-                if sC > 0.0:
-                    if s > 0.0:
-                        cjj = np.sqrt((C11 * xi / s) ** 2 + (C22 * eta / s) ** 2)
-                    else:
-                        cjj = C22
-                    eps = np.pi * G * a * b * cjj * sC / (4.0 * N * mu)
-                    F = 2.0 * N * mu / np.pi * (eps / (1.0 + eps * eps) + np.arctan(eps))
-                    Fx = -F * xi / sC
-                    Fy = -F * eta / sC
-                    KS = 1.0 + 6.3 * (1.0 - np.exp(-a / b))
-                    epsM = 8.0 / 3.0 * G * b * cc / (N * mu) * C23 * abs(syC) / KS
-                    dl = (epsM * epsM - 1.0) / (epsM * epsM + 1.0)
-                    q = 1.0 - dl * dl
-                    if q < 0.0:
-                        q = 0.0
-                    KM = abs(epsM) * (dl**3 / 3.0 - dl * dl / 2.0 + 1.0 / 6.0) - np.sqrt(q**3) / 3.0
-                    Fy += 9.0 / 16.0 * a * mu * N * KM * KS * phi / sC
-                beta = np.sqrt(Fxl * Fxl + Fyl * Fyl) / (mu * N)
-                fac = 1.0 - beta / 3.0 + beta * beta / 27.0 if beta < 3.0 else 1.0 / beta
-                Mz = Mzl * fac
+            Fx, Fy, Mz, xi, eta, phi = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            if model >= 0:
+                V = abs(vws[iw, 0] * tx + vws[iw, 1] * ty + vws[iw, 2] * tz)
+                if V < vmin:
+                    vmin = V
+                if V < 1e-3:
+                    continue
+                xi = (vx * tx + vy * ty + vz * tz) / V
+                eta = (vx * lx + vy * ly + vz * lz) / V
+                phi = (wx * n0 + wy * n1 + wz * n2) / V
+                if N > 0.0:
+                    Fx, Fy, Mz = creep_law(model, cp, xi, eta, phi, N, a, b, G, mu, C11, C22, C23, C33)
             out[i, 0] = N
             out[i, 1] = Fx
             out[i, 2] = Fy
@@ -327,21 +414,9 @@ def _define_kernel():
             Mg[i, 2] = Mz * n2
         return vmin
 
-    return kernel, normal_law
-
-
-_KERNEL = None
-
-
 def _kernels():
-    """(kernel, normal_law) compiled once, or None without numba."""
-    global _KERNEL
-    if _KERNEL is None:
-        try:
-            _KERNEL = _define_kernel()
-        except ImportError:  # pragma: no cover - numba missing
-            _KERNEL = False
-    return _KERNEL or None
+    """(kernel, normal_law) compiled on first use, or None without numba."""
+    return None if _numba is None else (kernel, normal_law)
 
 
 def _kernel():
@@ -371,16 +446,18 @@ class ContactForces:
     creep_model : str, CreepModel subclass or CreepModel
         Any creep law of :data:`railway.creep.CREEP_MODELS` by name or alias (``"kalker_linear"``,
         ``"shen_hedrick_elkins"``, ``"polach2000"``, ``"polach2005"``, ``"fastsim"``, or one
-        registered by the user), a :class:`railway.creep.CreepModel` class or an instance.
+        registered by the user), a :class:`railway.creep.CreepModel` class or an instance;
+        ``None`` for normal forces only (creepages and creep forces zero: static analyses of a
+        vehicle standing on its rails, where no rolling speed defines the creepages).
     restitution : float
         Coefficient of restitution c_e of the Lankarani-Nikravesh damping, in [0, 1].
     approach_velocity_floor : float
         Damping reference velocity v0 (m/s), see :func:`lankarani_nikravesh_force`.
     compiled : {"auto", True, False}
         ``"auto"``: the numba kernel when numba is installed *and* the kernel implements the creep
-        law (``kalker_linear`` or ``polach2000`` with ``join="scaled"``), else the numpy reference
-        path -- every other law (Shen-Hedrick-Elkins, Polach 2005, FASTSIM, user laws, another
-        join) runs there, never replaced by a compiled one.  ``True``: the kernel or an error;
+        law (every law of the package with ``join="scaled"``, and normal forces only), else the
+        numpy reference path -- user laws and other joins run there, never replaced by a compiled
+        one.  ``True``: the kernel or an error;
         ``False``: the reference path.  :attr:`compiled` tells which path is used.
     creep_params : dict, optional
         Constructor parameters of the creep law given by name or class (e.g. Polach 2005's
@@ -421,13 +498,18 @@ class ContactForces:
                 raise InputError(f"ContactForces: {name} = {val!r} is out of range")
         if compiled not in ("auto", True, False):
             raise InputError(f"compiled must be 'auto', True or False, got {compiled!r}")
-        self.creep_law = get_creep_model(creep_model, **(creep_params or {}))
-        self.creep_model = self.creep_law.name
+        if creep_model is None:  # normal forces only (static analyses: no rolling, no creep)
+            if creep_params:
+                raise InputError("ContactForces: creep_params given without a creep law")
+            self.creep_law, self.creep_model = None, None
+        else:
+            self.creep_law = get_creep_model(creep_model, **(creep_params or {}))
+            self.creep_model = self.creep_law.name
         code = _kernel_code(self.creep_law)
         if compiled is True and code is None:
             raise InputError(f"ContactForces: compiled=True, but the numba kernel implements only the "
-                             f"creep laws kalker_linear and polach2000 (join='scaled'), not "
-                             f"{self.creep_law!r}; use compiled='auto' or False (numpy reference path)")
+                             f"creep laws of railway.creep with join='scaled', not {self.creep_law!r}; "
+                             "use compiled='auto' or False (numpy reference path)")
         self.E, self.nu, self.mu = float(E), float(nu), float(mu)
         self.G = self.E / (2.0 * (1.0 + self.nu))
         self.restitution = float(restitution)
@@ -435,7 +517,7 @@ class ContactForces:
         self.v0 = float(approach_velocity_floor)
         self._ksum = 1.0 / (np.pi * float(np.ravel(effective_modulus(E, nu, E, nu))[0]))
         self._kernel = _kernel() if (compiled and code is not None) else None
-        self._model_code = code
+        self._model_code, self._model_params = (None, None) if code is None else code
         self._ws_of = None
         if compiled is True and self._kernel is None:
             raise ImportError("compiled=True needs numba")
@@ -515,7 +597,7 @@ class ContactForces:
                             res.point_wheel.reshape(M, 3), res.normal.reshape(M, 3), self._ws_of,
                             r_ws, v_ws, omega_ws, fwd, self._t0, self._dt, self._tab, self._ksum,
                             self.G, self.mu, self._chi, self.v0,
-                            self._model_code, out, Fg, Mg)
+                            self._model_code, self._model_params, out, Fg, Mg)
         if vmin < 1e-3:
             raise InputError(f"ContactForces: rolling speed {vmin!r} m/s at a loaded contact is "
                              "below 1e-3 m/s: creepages undefined")
@@ -545,12 +627,17 @@ class ContactForces:
             h = hertz_from_penetration(pen[on], A, B, self.E, self.nu, self.E, self.nu)
             P = res.point_wheel.reshape(M, 3)[on]
             n = res.normal.reshape(M, 3)[on]
-            xi, eta, phi = creepages(P, n, fwd[iw], r_ws[iw], v_ws[iw], omega_ws[iw])
             vw = v_ws[iw] + np.cross(omega_ws[iw], P - r_ws[iw])
             dd = -np.einsum("ij,ij->i", vw, n)
             N = lankarani_nikravesh_force(pen[on], dd, h.stiffness, self.restitution,
                                           approach_velocity_floor=self.v0)
-            f = self.creep_law(xi, eta, phi, N, h.a, h.b, self.G, self.nu, self.mu)
+            if self.creep_law is None:
+                zero = np.zeros(on.size)
+                xi = eta = phi = zero
+                f = CreepForces(zero, zero, zero)
+            else:
+                xi, eta, phi = creepages(P, n, fwd[iw], r_ws[iw], v_ws[iw], omega_ws[iw])
+                f = self.creep_law(xi, eta, phi, N, h.a, h.b, self.G, self.nu, self.mu)
             t = fwd[iw] - np.einsum("ij,ij->i", fwd[iw], n)[:, None] * n
             t /= np.linalg.norm(t, axis=1)[:, None]
             l = np.cross(n, t)

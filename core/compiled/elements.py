@@ -26,10 +26,12 @@ revolute angle driver ``Φ = cos f (g_iᵀ f_j) − sin f (f_iᵀ f_j)`` as in
 Forces: zero-length point spring ``F_P = k d + c ḋ``; spring-damper-actuator
 ``F_P = (k (L − L₀) + c L̇ + f_a(t)) u``; applied force and torque of time (global or body axes);
 plane contact ``F_n = max(0, K δᵖ (1 + χ δ̇/δ̇⁻))`` along the plane normal with optional
-regularised friction; each applied as ``Q_b += [F; C(s̄)ᵀF]``.  Exact Jacobian kernels for the
-two point-pair springs (stiffness and damping blocks with the lever-arm and velocity-transport
-terms of :func:`core.forces.coordinates.point_pair_jacobian`); the other force kinds are
-differenced by the implicit integrators.
+regularised friction; each applied as ``Q_b += [F; C(s̄)ᵀF]``; bump stop ``f = σ(u) g(|u|) + c u̇``
+on a dot-2 coordinate with a tabulated law; spring in series with a damper
+``F_s = k_s (ℓ − x − ℓ_s0)``, ``Q_x = F_s − c ẋ`` on its node coordinate.  Exact Jacobian kernels
+for the two point-pair springs and the series spring-damper (stiffness and damping blocks with the
+lever-arm and velocity-transport terms of :func:`core.forces.coordinates.point_pair_jacobian`, and
+the node couplings); the other force kinds are differenced by the implicit integrators.
 
 References
 ----------
@@ -901,6 +903,144 @@ def compile_bushings(kind, layout) -> CompiledForces:
                           names=list(kind.names), what="bushing")
 
 
+# --- bump stop (dot-2 coordinate with a tabulated law) -------------------------------------------
+
+
+@force_kernel
+def bump_stops(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
+    r"""Bump stop (:class:`core.forces.springs.BumpStop`): ``u = (A_i ē)ᵀ(r_Q − r_P) − u₀`` (dot-2),
+    ``f = σ(u) g(|u|) + c u̇`` while engaged (``|u| > d₀`` on an active side), ``Q = −f ∂u/∂q``.
+    ``g`` interpolates the table linearly, 0 inside the clearance, the last slope beyond the last row.
+    fd: s̄_i, s̄_j, ē, u₀, c, positive side, negative side, then the rows d_k, f_k, S_k (slopes) in
+    three blocks of K columns; ix: i, j, number of rows n, K."""
+    nb, dim = lay[L_NB], lay[L_DIM]
+    for e in range(ix.shape[0]):
+        bi, bj, n, K = ix[e, 0], ix[e, 1], ix[e, 2], ix[e, 3]
+        p0, p1, p2 = fd[e, 0], fd[e, 1], fd[e, 2]
+        s0, s1, s2 = fd[e, 3], fd[e, 4], fd[e, 5]
+        u0, u1, u2 = fd[e, 6], fd[e, 7], fd[e, 8]
+        d0, d1, d2 = V.rel_point(r, A, bi, p0, p1, p2, bj, s0, s1, s2)
+        a0, a1, a2 = V.Av(A, bi, u0, u1, u2)
+        u = a0 * d0 + a1 * d1 + a2 * d2 - fd[e, 9]
+        side = fd[e, 11] if u >= 0.0 else fd[e, 12]
+        if side == 0.0:
+            continue
+        s = abs(u)
+        k = -1
+        for m in range(n):  # the segment of |u|: the last row with d_m ≤ |u|
+            if fd[e, 13 + m] <= s:
+                k = m
+        if k < 0:
+            continue
+        g = fd[e, 13 + K + k] + fd[e, 13 + 2 * K + k] * (s - fd[e, 13 + k])
+        f = g if u >= 0.0 else -g
+        x0_, x1_, x2_ = V.uC(A, bi, u0, u1, u2, d0, d1, d2)
+        y0, y1, y2 = V.uC(A, bi, p0, p1, p2, a0, a1, a2)
+        ci0, ci1, ci2 = x0_ - y0, x1_ - y1, x2_ - y2
+        cj0, cj1, cj2 = V.uC(A, bj, s0, s1, s2, a0, a1, a2)
+        if s > fd[e, 13] and fd[e, 10] != 0.0:
+            ud = (-a0 * rd[bi, 0] - a1 * rd[bi, 1] - a2 * rd[bi, 2] + a0 * rd[bj, 0] + a1 * rd[bj, 1]
+                  + a2 * rd[bj, 2] + _rotation_rate(w, bi, bj, ci0, ci1, ci2, cj0, cj1, cj2))
+            f += fd[e, 10] * ud
+        V.add_block(Q, bi, nb, dim, -a0, -a1, -a2, ci0, ci1, ci2, -f)
+        V.add_block(Q, bj, nb, dim, a0, a1, a2, cj0, cj1, cj2, -f)
+    return OK
+
+
+def compile_bump_stops(kind, layout) -> CompiledForces:
+    K = kind.D.shape[1]
+    D = np.where(np.isfinite(kind.D), kind.D, 0.0)  # rows beyond n are never read
+    fd = np.hstack([pad3(kind.si), pad3(kind.sj), pad3(kind.ei), kind.u0[:, None], kind.c[:, None],
+                    kind.positive.astype(float)[:, None], kind.negative.astype(float)[:, None], D, kind.F, kind.S])
+    ix = _ints(kind.bi, kind.bj, kind.n_rows, np.full(len(kind.bi), K))
+    return CompiledForces(forces=bump_stops, fd=np.ascontiguousarray(fd), ix=ix, names=list(kind.names),
+                          what="bump stop")
+
+
+# --- spring in series with a damper (node = extra coordinate) -------------------------------------
+
+
+@force_kernel
+def series_spring_dampers(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
+    r"""Maxwell element (:class:`core.forces.springs.SeriesSpringDamper`): ``F_s = k_s (ℓ − x − ℓ_s0)``,
+    ``F_P = F_s n`` on P, ``−F_s n`` on Q, ``Q_x = F_s − c ẋ`` on the node coordinate x
+    (fd: s̄_i, s̄_j, k_s, c, ℓ_s0; ix: i, j, q index and v index of x)."""
+    nb, dim = lay[L_NB], lay[L_DIM]
+    for e in range(ix.shape[0]):
+        bi, bj, xq, xv = ix[e, 0], ix[e, 1], ix[e, 2], ix[e, 3]
+        p0, p1, p2 = fd[e, 0], fd[e, 1], fd[e, 2]
+        q0, q1, q2 = fd[e, 3], fd[e, 4], fd[e, 5]
+        d0, d1, d2 = V.rel_point(r, A, bi, p0, p1, p2, bj, q0, q1, q2)
+        L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if L < 1e-12:
+            err[1] = e
+            return COINCIDENT
+        Fs = fd[e, 6] * (L - q[xq] - fd[e, 8])
+        f = Fs / L
+        V.add_point_force(Q, A, bi, nb, dim, p0, p1, p2, f * d0, f * d1, f * d2, 1.0)
+        V.add_point_force(Q, A, bj, nb, dim, q0, q1, q2, f * d0, f * d1, f * d2, -1.0)
+        Q[xv] += Fs - fd[e, 7] * v[xv]
+    return OK
+
+
+@force_jacobian_kernel
+def series_spring_dampers_jacobian(t, q, v, r, A, rd, w, lay, fd, ix, state, K, D, err):
+    """Exact Jacobian of :func:`series_spring_dampers`: body blocks of a spring with tension F_s
+    (``∂F/∂d = k_s n nᵀ + F_s (I − n nᵀ)/ℓ``, no damping between the bodies) and the node couplings
+    ``∂Q_b/∂x = ∂Q_x/∂δw_b = k_s g_b`` (``g_i = −J_Pᵀn``, ``g_j = J_Qᵀn``), ``∂Q_x/∂x = −k_s``,
+    ``∂Q_x/∂ẋ = −c``."""
+    nb, dim = lay[L_NB], lay[L_DIM]
+    Kd = np.zeros((3, 3))
+    Cd = np.zeros((3, 3))
+    F = np.zeros(3)
+    si = np.zeros(3)
+    sj = np.zeros(3)
+    u = np.zeros(3)
+    Jp, Jq, Vp, Vq, T = np.zeros((3, 6)), np.zeros((3, 6)), np.zeros((3, 6)), np.zeros((3, 6)), np.zeros((3, 6))
+    for e in range(ix.shape[0]):
+        bi, bj, xq, xv = ix[e, 0], ix[e, 1], ix[e, 2], ix[e, 3]
+        for i in range(3):
+            si[i] = fd[e, i]
+            sj[i] = fd[e, 3 + i]
+        k, c = fd[e, 6], fd[e, 7]
+        d0, d1, d2 = V.rel_point(r, A, bi, si[0], si[1], si[2], bj, sj[0], sj[1], sj[2])
+        L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if L < 1e-12:
+            err[1] = e
+            return COINCIDENT
+        u[0], u[1], u[2] = d0 / L, d1 / L, d2 / L
+        Fs = k * (L - q[xq] - fd[e, 8])
+        for i in range(3):
+            F[i] = Fs * u[i]
+            for j in range(3):
+                Kd[i, j] = k * u[i] * u[j] + Fs * ((1.0 if i == j else 0.0) - u[i] * u[j]) / L
+        point_pair_jacobian(A, w, nb, dim, bi, si, bj, sj, F, Kd, Cd, K, D, Jp, Jq, Vp, Vq, T)
+        for side in range(2):
+            b = bi if side == 0 else bj
+            if b >= nb:
+                continue
+            sg = -1.0 if side == 0 else 1.0
+            s = si if side == 0 else sj
+            c0, c1, c2 = V.uC(A, b, s[0], s[1], s[2], u[0], u[1], u[2])
+            g = (u[0], u[1], u[2], c0, c1, c2)  # J_bᵀ n in 3-D block form
+            for a in range(6):
+                ia = _idx6(b, a, nb, dim)
+                if ia < 0:
+                    continue
+                K[ia, xv] += sg * k * g[a]
+                K[xv, ia] += sg * k * g[a]
+        K[xv, xv] -= k
+        D[xv, xv] -= c
+    return OK
+
+
+def compile_series_spring_dampers(kind, layout) -> CompiledForces:
+    fd = np.hstack([pad3(kind.si), pad3(kind.sj), kind.k[:, None], kind.c[:, None], kind.ls0[:, None]])
+    ix = _ints(kind.bi, kind.bj, kind.xq, kind.xv)
+    return CompiledForces(forces=series_spring_dampers, fd=np.ascontiguousarray(fd), ix=ix, names=list(kind.names),
+                          jacobian=series_spring_dampers_jacobian, what="series spring-damper")
+
+
 # --- plane contact ------------------------------------------------------------------------------
 
 
@@ -953,5 +1093,6 @@ __all__ = [
     "point_position_driver", "planar_angle_driver", "spatial_angle_driver",
     "point_springs", "spring_dampers", "applied_forces", "applied_torques", "plane_contacts",
     "point_springs_jacobian", "spring_dampers_jacobian", "point_pair_jacobian",
+    "bump_stops", "series_spring_dampers", "series_spring_dampers_jacobian",
 ]
 

@@ -232,13 +232,37 @@ class CompiledModel:
         self.n_b = int(fields["lay"][0])
         self.n_q, self.n_v = int(fields["lay"][4]), int(fields["lay"][5])
         self.stateful = bool(np.any(fields["frc_stateful"]))
+        self._st_off, self._st_n, self._st_w = fields["st_off"], fields["st_n"], fields["st_w"]
         #: set-up results of integrators kept with the model (e.g. the Radau unknowns' ordering)
         self.setup_cache: dict = {}
 
     def initial_states(self) -> np.ndarray:
         """A fresh copy of the force kinds' search states (one per integrator run), stored flat
-        (see :data:`KERNEL_FIELDS`)."""
-        return self._states.copy()
+        (see :data:`KERNEL_FIELDS`); kinds with an ``initial_state`` callback supply the state of
+        the run's initial conditions (call after the system's ``begin_run``)."""
+        out = self._states.copy()
+        for k, rec in enumerate(self.force_kinds):
+            cb = getattr(rec, "initial_state", None)
+            if cb is None:
+                continue
+            blk = np.asarray(cb(), dtype=float)
+            a, b = int(self._st_off[k]), int(self._st_off[k + 1])
+            if blk.size != b - a:
+                raise RuntimeError(f"{rec.what} {rec.names[0]!r}: initial_state() returned {blk.size} values, "
+                                   f"the state holds {b - a}")
+            out[a:b] = blk.ravel()
+        return out
+
+    def failure_description(self, kind: int, states: np.ndarray) -> str:
+        """The kind's own description of a failure its kernels reported ('' if none)."""
+        if not (0 <= kind < len(self.force_kinds)):
+            return ""
+        rec = self.force_kinds[kind]
+        cb = getattr(rec, "describe_failure", None)
+        if cb is None:
+            return ""
+        a, b = int(self._st_off[kind]), int(self._st_off[kind + 1])
+        return str(cb(np.asarray(states[a:b]).reshape(int(self._st_n[kind]), int(self._st_w[kind]))))
 
     def element_name(self, family: str, kind: int, element: int) -> str:
         """Name of the element a kernel reported in ``err`` (family 'force' or 'constraint')."""

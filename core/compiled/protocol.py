@@ -207,6 +207,14 @@ class CompiledForces:
         Initial search state (copied per integrator run).
     what : str
         Kind description for messages (e.g. ``"point spring"``).
+    initial_state : callable, optional
+        ``initial_state() -> ndarray`` of ``state``'s shape, called at the start of every run
+        after the kind's :meth:`~core.forces.protocol.ForceKind.reset_state` (the state of a
+        run's initial conditions, where ``state`` is only that of the model's build).
+    describe_failure : callable, optional
+        ``describe_failure(state) -> str``: the cause of a failure the kind's kernels reported
+        (e.g. which wheel derailed), read from its state block at the failure; appended to the
+        run's message.
     """
 
     forces: object
@@ -217,6 +225,8 @@ class CompiledForces:
     accept: object | None = None
     state: np.ndarray = field(default_factory=_empty2)
     what: str = "force element"
+    initial_state: object | None = None
+    describe_failure: object | None = None
 
 
 @dataclass

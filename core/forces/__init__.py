@@ -7,7 +7,8 @@ module                 contents
                        :class:`ForceJacobian`; the search-state hook of stateful kinds
 ``coordinates``        point Jacobians and element coordinates with exact Jacobians
 ``springs``            :class:`SpringDamper`, :class:`PointSpring`,
-                       :class:`RotationalSpringDamper`, :class:`Bushing`
+                       :class:`RotationalSpringDamper`, :class:`Bushing`, :class:`BumpStop`,
+                       :class:`SeriesSpringDamper`
 ``loads``              :class:`AppliedForce`, :class:`AppliedTorque`
 ``contact``            :class:`PlaneContact` (laws from :mod:`core.contact_laws`)
 =====================  ========================================================================
@@ -22,12 +23,16 @@ from .contact import PlaneContact, PlaneContactKind, hertz_sphere_plane_stiffnes
 from .loads import AppliedForce, AppliedForceKind, AppliedTorque, AppliedTorqueKind
 from .protocol import ForceElement, ForceEval, ForceJacobian, ForceKind
 from .springs import (
+    BumpStop,
+    BumpStopKind,
     Bushing,
     BushingKind,
     PointSpring,
     PointSpringKind,
     RotationalSpringDamper,
     RotationalSpringDamperKind,
+    SeriesSpringDamper,
+    SeriesSpringDamperKind,
     SpringDamper,
     SpringDamperKind,
 )
@@ -45,6 +50,10 @@ __all__ = [
     "RotationalSpringDamperKind",
     "Bushing",
     "BushingKind",
+    "BumpStop",
+    "BumpStopKind",
+    "SeriesSpringDamper",
+    "SeriesSpringDamperKind",
     "AppliedForce",
     "AppliedForceKind",
     "AppliedTorque",

@@ -7,6 +7,9 @@ element                         law (details in each class)
 :class:`PointSpring`            ``F = k d + c ḋ`` (zero free length; the "penalty joint")
 :class:`RotationalSpringDamper` ``T = k (θ − θ₀) + c θ̇ + T_a(t)`` about a relative angle
 :class:`Bushing`                ``f = K Δ + C Δ̇`` on the 3/6 relative deflections of two markers
+:class:`BumpStop`               ``f = ±g(|u|) + c u̇`` beyond a clearance along a body-fixed axis
+:class:`SeriesSpringDamper`     spring ``k_s`` in series with a damper ``c`` (Maxwell element); the
+                                series node is an extra coordinate with a small mass
 =============================== ==============================================================
 
 All supply exact Jacobians (:mod:`core.forces.coordinates`).
@@ -49,6 +52,10 @@ __all__ = [
     "RotationalSpringDamperKind",
     "Bushing",
     "BushingKind",
+    "BumpStop",
+    "BumpStopKind",
+    "SeriesSpringDamper",
+    "SeriesSpringDamperKind",
 ]
 
 
@@ -590,3 +597,436 @@ class BushingKind(ForceKind):
         from ..compiled.elements import compile_bushings
 
         return compile_bushings(self, layout)
+
+
+# --------------------------------------------------------------------------------------------
+# bump stop (clearance spring with a tabulated force law)
+# --------------------------------------------------------------------------------------------
+
+_SIDES = ("both", "positive", "negative")
+
+
+@dataclass(frozen=True)
+class BumpStop(ForceElement):
+    r"""Clearance spring (bump stop) between two bodies along a body-fixed axis, tabulated force law.
+
+    A marker on body i has its origin P at ``at`` and the unit direction ``e = A_i ē`` (``axis``,
+    given globally at build, stored body-fixed; normalised here); Q is a point of body j
+    (``point_j``, default ``at``).  The deflection is the relative displacement along e from
+    the build configuration,
+
+    .. math::
+
+        u = e^T (r_Q - r_P) - u_0 ,
+
+    (a dot-2 element coordinate, Haug 1989, Sec. 9.2; ``u_0`` its value at build).  The table
+    ``(d_k, f_k)``, k = 0 … n−1 (total relative displacement d_k ≥ 0 [m] strictly increasing,
+    force f_k ≥ 0 [N] non-decreasing, f_0 = 0) defines the force magnitude for a gap closure
+    ``s = |u|``:
+
+    .. math::
+
+        g(s) = \begin{cases}
+            0 & s < d_0 \quad\text{(the clearance)}\\
+            f_k + S_k (s - d_k) & d_k \le s < d_{k+1}\\
+            f_{n-1} + S_{n-2} (s - d_{n-1}) & s \ge d_{n-1}
+        \end{cases},\qquad S_k = \frac{f_{k+1} - f_k}{d_{k+1} - d_k},
+
+    linear interpolation with the last slope beyond the last row.  The element force is
+
+    .. math::
+
+        f = \sigma(u)\,g(|u|) + c\,\dot u\,[\text{engaged}],\qquad
+        δW = -f\,δu,
+
+    with ``σ(u) = sgn u`` for ``sides="both"`` (a symmetric stop: the law is odd in u),
+    ``σ = [u ≥ 0]`` for ``"positive"`` (a stop only against u > 0) and ``σ = −[u < 0]`` for
+    ``"negative"``; *engaged* means ``|u| > d_0`` on an active side, and the damping c [N s/m]
+    acts only then (it switches on with a jump ``c u̇`` at the clearance, and may pull while the
+    bodies separate: no clipping).
+
+    **Sign.**  ``Q = −f ∂u/∂q``: the force ``−f e`` acts at Q on body j and ``+f e`` at P on
+    body i (with the moment that balances it, including the term from the rotation of e with
+    body i, so the undamped stop is exactly conservative with potential ``V = ∫₀ᵘ f du``).  A
+    positive u beyond the clearance (Q moved along +e) gives f > 0, which pushes Q back along −e
+    and P along +e: the stop resists relative displacement beyond the clearance on either side.
+
+    **Jacobians** are exact (the dot-2 coordinate's gradient and Hessian,
+    :func:`core.forces.coordinates.coordinate_jacobian`) with ``∂f/∂u = g'(|u|)`` and
+    ``∂f/∂u̇ = c`` while engaged.  ``g`` is continuous but its slope jumps at the table rows: at a
+    row ``|u| = d_k`` (and at the clearance ``|u| = d_0``) the slope of the outer segment
+    ``S_k`` (the right derivative in |u|) is used, inside the clearance the slope is 0; these
+    one-sided derivatives are what the Newton iterations of the implicit integrators see.
+
+    Parameters
+    ----------
+    at : array_like, shape (d,)
+        Global position of P at build [m] (and of Q unless ``point_j``).
+    axis : array_like, shape (d,)
+        Global direction of the stop axis e at build (normalised; fixed to body i).
+    table : array_like, shape (n, 2), n ≥ 2
+        Rows ``(d_k [m], f_k [N])``: total relative displacement and force, SI units.
+    damping : float
+        c [N s/m], ≥ 0, acting only while engaged.
+    sides : {"both", "positive", "negative"}
+        Which side(s) of the clearance the stop acts on.
+    point_j : array_like, shape (d,), optional
+        Global position of Q at build [m].
+
+    Examples
+    --------
+    The Manchester benchmark vehicle's lateral bump stop between bogie frame and car body
+    (Iwnicki 1998), clearance 25 mm, table converted from mm and N to SI::
+
+        mm = [25, 30, 35, 40, 45, 50, 55, 60, 65]
+        kN = [0, 0.6, 1.76, 3.73, 6.87, 11.58, 17.17, 29.2, 230.0]
+        b.add_bump_stop("lateral stop", "bogie", "body", at, (0, 1, 0),
+                        np.column_stack([np.array(mm) * 1e-3, np.array(kN) * 1e3]))
+
+    References
+    ----------
+    E. J. Haug, *Computer-Aided Kinematics and Dynamics of Mechanical Systems*, 1989, Sec. 9.2.
+    S. Iwnicki (ed.), "The Manchester benchmarks for rail vehicle simulation", Vehicle System
+    Dynamics 30(3–4) (1998) 295–313.
+    """
+
+    name: str
+    body_i: str
+    body_j: str
+    at: Any
+    axis: Any
+    table: Any
+    damping: float = 0.0
+    sides: str = "both"
+    point_j: Any = None
+
+    @classmethod
+    def compile(cls, elements, ctx):
+        return BumpStopKind(elements, ctx)
+
+
+def _bump_stop_table(table, name: str) -> Array:
+    """The validated force table of bump stop ``name`` as an (n, 2) float array."""
+    try:
+        T = np.array(table, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"bump stop {name!r}: table must be rows (displacement [m], force [N]), "
+                         f"got {table!r}") from None
+    if T.ndim != 2 or T.shape[1] != 2 or T.shape[0] < 2:
+        raise ModelError(f"bump stop {name!r}: table must have shape (n, 2) with n ≥ 2 rows "
+                         f"(displacement [m], force [N]), got shape {T.shape}")
+    if not np.all(np.isfinite(T)):
+        k = int(np.argmax(~np.all(np.isfinite(T), 1)))
+        raise ModelError(f"bump stop {name!r}: table row {k} is not finite: {T[k].tolist()}")
+    d, f = T[:, 0], T[:, 1]
+    if d[0] < 0:
+        raise ModelError(f"bump stop {name!r}: the first displacement (the clearance) must be ≥ 0, got {d[0]} m")
+    if f[0] != 0:
+        raise ModelError(f"bump stop {name!r}: the first row is the clearance and must have force 0, got {f[0]} N")
+    bad = np.flatnonzero(np.diff(d) <= 0)
+    if len(bad):
+        k = int(bad[0])
+        raise ModelError(f"bump stop {name!r}: displacements must increase strictly (a repeated displacement "
+                         f"would be a force jump of infinite slope), row {k + 1} has {d[k + 1]} m after {d[k]} m")
+    bad = np.flatnonzero(np.diff(f) < 0)
+    if len(bad):
+        k = int(bad[0])
+        raise ModelError(f"bump stop {name!r}: forces must not decrease, row {k + 1} has {f[k + 1]} N "
+                         f"after {f[k]} N")
+    return T
+
+
+class BumpStopKind(ForceKind):
+    """All :class:`BumpStop` elements of a model (tables padded to the longest one)."""
+
+    def __init__(self, elements: list[BumpStop], ctx):
+        d = ctx.space.dim
+        self.names = [e.name for e in elements]
+        n = len(elements)
+        bi, bj, si, sj, ei, tables = [], [], [], [], [], []
+        for e in elements:
+            a, b = two_bodies(ctx, e)
+            p = np.asarray(e.at, float)
+            q = p if e.point_j is None else np.asarray(e.point_j, float)
+            if p.shape != (d,) or q.shape != (d,) or not (np.all(np.isfinite(p)) and np.all(np.isfinite(q))):
+                raise ModelError(f"bump stop {e.name!r}: 'at' and 'point_j' must be {d} finite numbers")
+            ax = np.asarray(e.axis, float)
+            nrm = float(np.linalg.norm(ax)) if ax.shape == (d,) else np.nan
+            if not (np.isfinite(nrm) and nrm > 1e-12):
+                raise ModelError(f"bump stop {e.name!r}: axis must be {d} finite numbers, not all zero, "
+                                 f"got {np.asarray(e.axis).tolist()}")
+            if e.sides not in _SIDES:
+                raise ModelError(f"bump stop {e.name!r}: sides must be one of {', '.join(_SIDES)}, got {e.sides!r}")
+            tables.append(_bump_stop_table(e.table, e.name))
+            bi.append(a)
+            bj.append(b)
+            si.append(ctx.local_point(a, p))
+            sj.append(ctx.local_point(b, q))
+            ei.append(ctx.local_vector(a, ax / nrm))
+        self.bi, self.bj = np.array(bi, np.int64), np.array(bj, np.int64)
+        self.si, self.sj, self.ei = np.array(si), np.array(sj), np.array(ei)
+        self.c = np.array([nonnegative(e.damping, "damping", e.name) for e in elements])
+        self.positive = np.array([e.sides in ("both", "positive") for e in elements])
+        self.negative = np.array([e.sides in ("both", "negative") for e in elements])
+        # padded tables: D (displacements, +inf beyond the last row), F, slopes S, energies E
+        K = max(len(T) for T in tables)
+        self.n_rows = np.array([len(T) for T in tables], np.int64)
+        self.D = np.full((n, K), np.inf)
+        self.F, self.S, self.E = np.zeros((n, K)), np.zeros((n, K)), np.zeros((n, K))
+        for k, T in enumerate(tables):
+            m = len(T)
+            dk, fk = T[:, 0], T[:, 1]
+            slope = np.diff(fk) / np.diff(dk)
+            self.D[k, :m], self.F[k, :m] = dk, fk
+            self.S[k, :m] = np.append(slope, slope[-1])  # the last slope beyond the last row
+            self.E[k, 1:m] = np.cumsum(0.5 * (fk[1:] + fk[:-1]) * np.diff(dk))  # ∫ g from d_0 to d_k
+        self.conservative = not np.any(self.c > 0)
+        self.u0 = self._coord(ctx.bs0).x[:, 0]
+
+    def _coord(self, bs) -> ElementCoordinate:
+        return dot2_coordinate(bs, self.bi, self.ei, self.si, self.bj, self.sj)
+
+    def law(self, u: Array) -> tuple[Array, Array, Array, Array]:
+        """Spring force ``σ(u) g(|u|)``, its slope ``∂f/∂u``, the potential ``∫₀ᵘ f`` and the
+        engaged flag, for deflections ``u`` (n,) [m] of the kind's elements (no damping)."""
+        n = len(u)
+        r = np.arange(n)
+        s = np.abs(u)
+        k = np.sum(self.D <= s[:, None], axis=1) - 1  # segment of |u| (−1: inside the clearance)
+        kk = np.maximum(k, 0)
+        ds = s - self.D[r, kk]
+        side = np.where(u >= 0, self.positive, self.negative) & (k >= 0)
+        g = np.where(side, self.F[r, kk] + self.S[r, kk] * ds, 0.0)
+        slope = np.where(side, self.S[r, kk], 0.0)
+        V = np.where(side, self.E[r, kk] + self.F[r, kk] * ds + 0.5 * self.S[r, kk] * ds**2, 0.0)
+        g = np.where(np.isnan(u), np.nan, g)  # a diverged state stays visible
+        engaged = side & (s > self.D[:, 0])
+        return np.where(u >= 0, g, -g), slope, V, engaged
+
+    def _force(self, bs, c):
+        w = pair_velocity(bs, self.bi, self.bj)
+        u = c.x[:, 0] - self.u0
+        ud = np.einsum("nmr,nr->nm", c.G, w)[:, 0]
+        fs, slope, _, engaged = self.law(u)
+        cd = np.where(engaged, self.c, 0.0)
+        return u, ud, fs + cd * ud, slope, cd, engaged, w
+
+    def evaluate(self, bs, t):
+        c = self._coord(bs)
+        f = self._force(bs, c)[2]
+        return coordinate_forces(self.bi, self.bj, c, f[:, None], bs.space.n_v)
+
+    def jacobian(self, bs, t):
+        c = self._coord(bs)
+        _, _, f, slope, cd, _, w = self._force(bs, c)
+        return coordinate_jacobian(self.bi, self.bj, c, f[:, None], slope[:, None], cd[:, None], w, bs.space.n_v)
+
+    def potential(self, bs):
+        u = self._coord(bs).x[:, 0] - self.u0
+        return float(np.sum(self.law(u)[2]))
+
+    def outputs(self, bs, t):
+        c = self._coord(bs)
+        u, _, f, _, _, engaged, _ = self._force(bs, c)
+        return {"u [m]": u, "engaged": engaged.astype(float), "F [N]": f}
+
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_bump_stops`; Jacobian by differences on
+        the compiled path)."""
+        from ..compiled.elements import compile_bump_stops
+
+        return compile_bump_stops(self, layout)
+
+
+# --------------------------------------------------------------------------------------------
+# spring in series with a damper (Maxwell element)
+# --------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SeriesSpringDamper(ForceElement):
+    r"""Spring ``k_s`` in series with a damper ``c`` (a Maxwell element) along the line PQ.
+
+    Typical use: a yaw or lateral damper with the stiffness of its rubber mounts.  P is a point
+    of body i, Q of body j; ``ℓ = |r_Q − r_P|``, ``n = (r_Q − r_P)/ℓ``.  The node N between the
+    damper (P–N) and the spring (N–Q) lies on the line at ``r_N = r_P + x n``; its position x
+    along PQ, measured from P, is an **extra coordinate of the model** with a small mass m_n (the
+    damper's moving mass: piston and rod), created by
+    :meth:`core.model.ModelBuilder.add_series_spring_damper` (``add_coordinate(f"{name}.node",
+    x_0, mass=m_n)``).  Tensions (positive pulling the ends together):
+
+    .. math::
+
+        F_s = k_s (\ell - x - \ell_{s0}), \qquad F_d = c\,\dot x,
+
+    spring N–Q of length ``ℓ − x`` and free length ``ℓ_{s0}``, damper P–N of length x.  The
+    virtual work of the two tensions, ``δW = −F_s δ(ℓ − x) − F_d δx = −F_s δℓ + (F_s − F_d) δx``
+    with ``δℓ = nᵀ(δr_Q − δr_P)``, gives the generalized forces
+
+    .. math::
+
+        Q_x = F_s - F_d \;(\text{so } m_n \ddot x = F_s - c\,\dot x), \qquad
+        F_P = +F_s\,n \text{ at P (body i)}, \qquad F_Q = -F_s\,n \text{ at Q (body j)},
+
+    i.e. the bodies feel the spring tension along PQ, the damper acts on them through the node.
+    The node's kinetic energy is taken as ``½ m_n ẋ²`` (relative to P along PQ): the node's
+    share of the bodies' motion is neglected, which is consistent while ``m_n`` is small against
+    the body masses (its role is to regularise the series node).  With ``c = 0`` the element is
+    conservative with potential ``½ k_s (ℓ − x − ℓ_{s0})²``.  Dynamic stiffness between P and Q
+    (ends moved harmonically along PQ, frequency ω):
+
+    .. math::
+
+        k^*(ω) = k_s \frac{iωc - m_n ω^2}{k_s + iωc - m_n ω^2}
+        \;\xrightarrow{m_n \to 0}\; k_s \frac{iωτ}{1 + iωτ}, \qquad τ = c / k_s .
+
+    ``free_length`` ``L_f`` is the distance PQ at which the spring is relaxed with the node at
+    its initial position x_0 (default: the distance at build): ``ℓ_{s0} = L_f − x_0``.
+
+    **Stiffness.**  The node adds the eigenvalue ``≈ −c/m_n`` (and, for small c, the node
+    oscillation ``√(k_s/m_n)``), e.g. c = 300 kN s/m, m_n = 5 kg: −6·10⁴ 1/s.  Explicit
+    integrators are limited to steps of order ``m_n/c`` by stability (the stiffness test of the
+    compiled explicit methods reports it); use ``jit-radau`` (or another implicit method).  A
+    massless node (a first-order state ``ẋ = F_s/c``) is not supported by core today, whose
+    integrators are second order in (q, v).  Attainable accuracy: the node rate follows the
+    positions with the gain ``1/τ = k_s/c`` (``ẋ ≈ F_s/c``), so the round-off of ``ℓ − x`` (≈ ε ℓ)
+    puts a floor ``≈ ε ℓ k_s/c`` under its error; an absolute velocity tolerance below that cannot
+    be met and the step size of an adaptive method collapses (for c = 300 kN s/m, k_s = 5 MN/m:
+    4e-15 m/s, harmless; for a near-rigid spring, τ = 10 µs: 2e-11 m/s).
+
+    **Jacobians** are exact: the body blocks of a spring-damper with tension F_s (stiffness
+    ``k_s n nᵀ + F_s (I − n nᵀ)/ℓ``, lever-arm terms), plus the couplings with the node
+    (:attr:`ForceJacobian.entries`): ``∂Q_i/∂x = −k_s J_Pᵀ n``, ``∂Q_j/∂x = k_s J_Qᵀ n``,
+    ``∂Q_x/∂δw_i = −k_s nᵀ J_P``, ``∂Q_x/∂δw_j = k_s nᵀ J_Q``, ``∂Q_x/∂x = −k_s``,
+    ``∂Q_x/∂ẋ = −c``.
+
+    Parameters
+    ----------
+    point_i, point_j : array_like, shape (d,)
+        Global positions of P and Q at build [m] (distinct).
+    stiffness : float
+        k_s [N/m], ≥ 0.
+    damping : float
+        c [N s/m], ≥ 0.
+    node : str
+        Name of the extra coordinate x (it must have a mass > 0; the builder helper makes it).
+    free_length : float, optional
+        L_f [m], ≥ 0.
+    """
+
+    name: str
+    body_i: str
+    body_j: str
+    point_i: Any
+    point_j: Any
+    stiffness: float
+    damping: float
+    node: str
+    free_length: float | None = None
+
+    @classmethod
+    def compile(cls, elements, ctx):
+        return SeriesSpringDamperKind(elements, ctx)
+
+
+class SeriesSpringDamperKind(ForceKind):
+    """All :class:`SeriesSpringDamper` elements of a model."""
+
+    def __init__(self, elements: list[SeriesSpringDamper], ctx):
+        d = ctx.space.dim
+        self.names = [e.name for e in elements]
+        bi, bj, si, sj, L0 = [], [], [], [], []
+        for e in elements:
+            a, b = two_bodies(ctx, e)
+            pi, pj = np.asarray(e.point_i, float), np.asarray(e.point_j, float)
+            if pi.shape != (d,) or pj.shape != (d,) or not (np.all(np.isfinite(pi)) and np.all(np.isfinite(pj))):
+                raise ModelError(f"series spring-damper {e.name!r}: points must be {d} finite numbers")
+            L = float(np.linalg.norm(pj - pi))
+            if L < 1e-9:
+                raise ModelError(f"series spring-damper {e.name!r}: the points P and Q coincide "
+                                 f"(distance {L:.3g} m): the line of action is undefined")
+            bi.append(a)
+            bj.append(b)
+            si.append(ctx.local_point(a, pi))
+            sj.append(ctx.local_point(b, pj))
+            L0.append(L if e.free_length is None else nonnegative(e.free_length, "free length", e.name))
+        self.bi, self.bj = np.array(bi, np.int64), np.array(bj, np.int64)
+        self.si, self.sj = np.array(si), np.array(sj)
+        self.k = np.array([nonnegative(e.stiffness, "stiffness", e.name) for e in elements])
+        self.c = np.array([nonnegative(e.damping, "damping", e.name) for e in elements])
+        self.xk = np.array([ctx.coordinate_index(e.node, e.name) for e in elements], np.int64)
+        seen: dict[int, str] = {}
+        for e, k in zip(elements, self.xk):
+            if int(k) in seen:
+                raise ModelError(f"series spring-damper {e.name!r}: node coordinate {e.node!r} is already the node "
+                                 f"of {seen[int(k)]!r} (each element needs its own)")
+            seen[int(k)] = e.name
+        self.xv = np.array([ctx.velocity_index(e.node, e.name) for e in elements], np.int64)
+        self.n_bodies = ctx.n_bodies
+        self.xq = self.n_bodies * ctx.space.n_q + self.xk  # q index of the node (compiled path)
+        self.ls0 = np.array(L0) - ctx.bs0.x[self.xk]  # spring free length ℓ_s0 = L_f − x_0
+        self.conservative = not np.any(self.c > 0)
+
+    def _geometry(self, bs):
+        dvec = bs.point(self.bj, self.sj) - bs.point(self.bi, self.si)
+        L = np.linalg.norm(dvec, axis=1)
+        if np.any(L < 1e-12):
+            k = int(np.argmin(L))
+            raise FloatingPointError(f"series spring-damper {self.names[k]!r}: attachment points coincide "
+                                     f"(length {L[k]:.3g} m)")
+        return dvec, L, dvec / L[:, None]
+
+    def _tensions(self, bs):
+        _, L, u = self._geometry(bs)
+        x, xd = bs.x[self.xk], bs.xdot[self.xk]
+        return L, u, x, xd, self.k * (L - x - self.ls0), self.c * xd
+
+    def evaluate(self, bs, t):
+        _, u, _, _, Fs, Fd = self._tensions(bs)
+        F = Fs[:, None] * u  # on P (body i)
+        Qi = np.einsum("ndk,nd->nk", point_jacobian(bs, self.bi, self.si), F)
+        Qj = -np.einsum("ndk,nd->nk", point_jacobian(bs, self.bj, self.sj), F)
+        return ForceEval(np.concatenate([self.bi, self.bj]), np.concatenate([Qi, Qj]), self.xk, Fs - Fd)
+
+    def jacobian(self, bs, t):
+        L, u, _, _, Fs, _ = self._tensions(bs)
+        dim, nv, nb = bs.space.dim, bs.space.n_v, self.n_bodies
+        P = np.eye(dim) - u[:, :, None] * u[:, None, :]
+        Kd = self.k[:, None, None] * u[:, :, None] * u[:, None, :] + (Fs / L)[:, None, None] * P
+        jac = point_pair_jacobian(bs, self.bi, self.si, self.bj, self.sj, Fs[:, None] * u, Kd,
+                                  np.zeros_like(Kd))
+        # couplings with the node: g_b = ∂ℓ/∂δw_b (−J_Pᵀn on i, +J_Qᵀn on j), ∂F_s/∂x = −k_s
+        gi = -np.einsum("ndk,nd->nk", point_jacobian(bs, self.bi, self.si), u)
+        gj = np.einsum("ndk,nd->nk", point_jacobian(bs, self.bj, self.sj), u)
+        rows, cols, kq = [], [], []
+        for b, g in ((self.bi, gi), (self.bj, gj)):
+            on = b < nb  # the ground has no velocity coordinates
+            idx = (b[on, None] * nv + np.arange(nv)).ravel()
+            val = (self.k[on, None] * g[on]).ravel()
+            xv = np.repeat(self.xv[on], nv)
+            rows += [idx, xv]  # ∂Q_b/∂x = ∂Q_x/∂δw_b = k_s g_b (symmetric: the spring is conservative)
+            cols += [xv, idx]
+            kq += [val, val]
+        rows.append(self.xv)
+        cols.append(self.xv)
+        kq.append(-self.k)
+        n_body = sum(len(r) for r in rows[:-1])
+        kv = np.concatenate([np.zeros(n_body), -self.c])
+        jac.entries = (np.concatenate(rows), np.concatenate(cols), np.concatenate(kq), kv)
+        return jac
+
+    def potential(self, bs):
+        _, L, _ = self._geometry(bs)
+        return float(np.sum(0.5 * self.k * (L - bs.x[self.xk] - self.ls0) ** 2))
+
+    def outputs(self, bs, t):
+        L, _, x, xd, Fs, Fd = self._tensions(bs)
+        return {"length [m]": L, "node [m]": x, "node rate [m/s]": xd, "spring force [N]": Fs,
+                "damper force [N]": Fd}
+
+    def compiled(self, layout):
+        """Compiled form (:func:`core.compiled.elements.compile_series_spring_dampers`, with its exact
+        Jacobian kernel)."""
+        from ..compiled.elements import compile_series_spring_dampers
+
+        return compile_series_spring_dampers(self, layout)

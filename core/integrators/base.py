@@ -202,7 +202,15 @@ class Integrator:
             self.t, self.q, self.v = self.t_old, self.q_old, self.v_old
             return self.message
         if self._stateful:
-            self.system.accept_step(self.t, self.q, self.v)
+            try:
+                self.system.accept_step(self.t, self.q, self.v)
+            except (IntegrationFailure, *RUN_FAILURES) as exc:
+                # an element found the accepted state unphysical (e.g. a derailed wheel): the
+                # run ends there, keeping that state as its last one
+                self.status = STATUS_FAILED
+                self.counters["n_steps"] += 1
+                self.message = f"{self.name} failed at t = {self.t:.6g} s: {exc}"
+                return self.message
         self.counters["n_steps"] += 1
         if self.t >= self.t_bound - 1e-12 * max(1.0, abs(self.t_bound)):
             self._finish()

@@ -411,6 +411,10 @@ class CompiledRK(Integrator):
         if code not in (_p.SINGULAR, _p.NONFINITE, _p.PROJECTION) and err[2] in (1, 2):
             family = "force" if err[2] == 1 else "constraint"
             why = f"{self._cm.element_name(family, int(err[0]), int(err[1]))}: {why}"
+            if err[2] == 1:
+                more = self._cm.failure_description(int(err[0]), self._states)
+                if more:
+                    why = f"{why}: {more}"
         return why
 
     def _initial_step(self, order):

@@ -176,6 +176,72 @@ def test_kernels_match_numpy_model(dim, joint, ground):
     _close(lam[: model.n_c], lam_ref, f"{joint} multipliers", 1e-10)
 
 
+def _suspension_model(dim, seed, ground=False, bump_stops=True):
+    """Two random bodies with bump stops (symmetric with damping, one-sided) and two series
+    spring-dampers (each with its node coordinate), plus a revolute joint."""
+    rng = np.random.default_rng(seed)
+    b = ModelBuilder(dim, f"suspension-{dim}d")
+    _body(b, rng, "a")
+    _body(b, rng, "b")
+    bi = "ground" if ground else "a"
+    at = rng.uniform(-1, 1, dim)
+    b.add_revolute("J", "ground", "a", rng.uniform(-1, 1, dim), None if dim == 2 else _unit(rng))
+    if bump_stops:
+        b.add_bump_stop("stop", bi, "b", at, _unit(rng, dim), [[0.005, 0.0], [0.02, 30.0], [0.05, 100.0], [0.2, 150.0]],
+                        damping=2.0, point_j=at + 0.05 * rng.standard_normal(dim))
+        b.add_bump_stop("stop-", "b", bi, at, _unit(rng, dim), [[0.0, 0.0], [0.01, 50.0], [0.03, 400.0]],
+                        damping=0.0, sides="negative")
+    b.add_series_spring_damper("yaw", bi, "b", at, at + rng.uniform(0.3, 1.0, dim), 200.0, 3.0, 0.05)
+    b.add_series_spring_damper("yaw2", "b", "a", at, at + rng.uniform(0.3, 1.0, dim), 100.0, 5.0, 0.02,
+                               free_length=0.9)
+    return b.build()
+
+
+@pytest.mark.parametrize("ground", [False, True])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_suspension_kernels_match_numpy_model(dim, ground):
+    """Bump-stop and series spring-damper kernels: forces and accelerations equal the numpy path to
+    round-off at perturbed states (stops in and out of contact, nodes off their rest positions);
+    the series element's exact Jacobian kernel equals the numpy Jacobian to round-off, and the
+    differenced Jacobian of the bump stops equals the numpy one to the forward-difference error
+    O(√ε) relative."""
+    model = _suspension_model(dim, seed=20 + dim, ground=ground)
+    only_series = _suspension_model(dim, seed=20 + dim, ground=ground, bump_stops=False)
+    engaged = set()
+    for m in (model, only_series):
+        cm = compile_model(m)
+        ws = make_workspace(cm)
+        st = cm.initial_states()
+        for seed in range(3):
+            q, v = _perturbed(m, seed)
+            t = 0.37
+            Q = np.zeros(m.n_v)
+            D.body_states(cm.fields["lay"], q, v, ws)
+            assert D.forces(cm.data, st, ws, t, q, v, Q) == P.OK
+            _close(Q, m.Q(t, q, v), "suspension Q")
+            a = np.zeros(m.n_v)
+            lam = np.zeros(max(m.n_c, 1))
+            assert D.accelerations(cm.data, st, ws, t, q, v, 0.0, 0.0, a, lam) == P.OK
+            a_ref, _ = accelerations_numpy(m, t, q, v)
+            _close(a, a_ref, "suspension accelerations", 1e-10)
+            K, Dm = np.zeros((m.n_v, m.n_v)), np.zeros((m.n_v, m.n_v))
+            work = np.zeros(m.n_q), np.zeros(m.n_v), np.zeros(m.n_v), np.zeros(m.n_v)
+            assert D.force_jacobian(cm.data, st, ws, t, q, v, K, Dm, *work) == P.OK
+            Kq, Kv = m.Q_jacobians(t, q, v)
+            if m is only_series:  # exact kernel
+                _close(K, Kq.toarray(), "series ∂Q/∂q", RT)
+                _close(Dm, Kv.toarray(), "series ∂Q/∂v", RT)
+            else:  # forward differences, step h = √ε: truncation O(h |∂²Q|) and round-off O(ε |Q| / h)
+                h = np.sqrt(np.finfo(float).eps)
+                scale = max(1.0, float(np.max(np.abs(Q))), float(np.max(np.abs(Kq.toarray()))))
+                assert np.max(np.abs(K - Kq.toarray())) <= 10 * h * scale, "suspension ∂Q/∂q"
+                assert np.max(np.abs(Dm - Kv.toarray())) <= 10 * h * scale, "suspension ∂Q/∂v"
+            for fk in m.force_kinds:
+                if "engaged" in (out := fk.outputs(m.body_states(q, v), t)):
+                    engaged |= set(out["engaged"].tolist())
+    assert engaged == {0.0, 1.0}  # the states cover stops in and out of contact
+
+
 def test_qdot_retract_normalize_match_model():
     model = _model(3, "spherical", seed=4)
     lay = compile_model(model).fields["lay"]

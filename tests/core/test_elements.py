@@ -289,6 +289,19 @@ def _force_model(dim, element, seed=0, gravity=None, conservative=False):
                       point_j=at + 0.1 * rng.standard_normal(dim))
     elif element == "bushing-ground":
         b.add_bushing("F", "b", "ground", at, 80.0, 20.0, 0.0 if conservative else 1.0, 0.0 if conservative else 0.5)
+    elif element == "bump-stop":
+        # clearance 5 mm, three segments and the last slope beyond; the perturbed states of the tests
+        # below are engaged (|u| of a few cm)
+        table = [[0.005, 0.0], [0.02, 30.0], [0.05, 100.0], [0.2, 150.0]]
+        b.add_bump_stop("F", "a", "b", at, _unit(rng, dim), table, damping=c, point_j=at + 0.1 * rng.standard_normal(dim))
+    elif element == "bump-stop-one-sided":
+        table = [[0.0, 0.0], [0.01, 50.0], [0.03, 400.0]]
+        b.add_bump_stop("F", "ground", "b", at, _unit(rng, dim), table, damping=2 * c, sides="negative")
+    elif element == "series-spring-damper":
+        b.add_series_spring_damper("F", "a", "b", at, at + rng.uniform(0.3, 1.0, dim), 200.0, 3 * c, 0.05,
+                                   free_length=0.8)
+    elif element == "series-spring-damper-ground":
+        b.add_series_spring_damper("F", "b", "ground", at, at + rng.uniform(0.3, 1.0, dim), 500.0, c, 0.2)
     elif element == "applied-force":
         comps = [2.0, drivers.harmonic(3.0, 2.0), (np.linspace(0, 2, 9), np.linspace(0, 2, 9) ** 2)][:dim]
         b.add_applied_force("F", "a", at, comps)
@@ -314,9 +327,11 @@ def _force_model(dim, element, seed=0, gravity=None, conservative=False):
 
 FORCE_ELEMENTS = ["spring-damper", "point-spring", "point-spring-coincident", "rotational", "rotational-ground",
                   "bushing", "bushing-ground", "applied-force", "applied-force-body", "applied-torque",
-                  "applied-torque-body", "plane-contact"]
+                  "applied-torque-body", "plane-contact", "bump-stop", "bump-stop-one-sided",
+                  "series-spring-damper", "series-spring-damper-ground"]
 CONSERVATIVE = ["spring-damper", "point-spring", "point-spring-coincident", "rotational", "rotational-ground",
-                "bushing", "bushing-ground", "plane-contact"]
+                "bushing", "bushing-ground", "plane-contact", "bump-stop", "bump-stop-one-sided",
+                "series-spring-damper", "series-spring-damper-ground"]
 
 
 @pytest.mark.parametrize("dim", [2, 3])

@@ -5,7 +5,8 @@ import pytest
 from core.scenes import Scene, run_scene
 from railway.scenes import railway_scenes
 
-NAMES = ["railway-contact-geometry", "railway-creep-curves", "railway-two-point-contact"]
+NAMES = ["railway-contact-geometry", "railway-creep-curves", "railway-two-point-contact",
+         "railway-manchester-contact"]
 
 
 def test_scene_list():

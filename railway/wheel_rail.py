@@ -1,0 +1,705 @@
+r"""The wheel–rail contact as a force element of the core: every wheel of a vehicle in one call.
+
+A :class:`WheelRailContact` names the wheelset bodies of a model, the track they run on, the
+wheel and rail profiles and the creep law.  At ``build()`` it becomes one :class:`WheelRailKind`
+that evaluates all wheels together: contact search on the swept rails
+(:mod:`railway.contact_search`: tread and flange candidates, so two-point contact is found),
+Hertz normal force with Lankarani–Nikravesh hysteresis damping and the creep law
+(:mod:`railway.forces`), and the generalized forces on the wheelset bodies and, where the rails
+belong to a body, on that body.
+
+Wheelset bodies
+---------------
+A wheelset is a spatial rigid body whose centre of mass lies on the axle, the wheel centres at
+±L along its body y axis (the axle, pointing to the left wheel); x is forward and z up in the
+reference configuration.  The wheelset keeps its spin as a full coordinate (absolute
+coordinates, Euler parameters): its rotation about the axle is integrated like any other
+rotation, and the rolling speed ω_a = ω · a is an output.  Because a wheel is a body of
+revolution about a, the contact geometry depends on the axle direction only; the search uses
+the *unspun* frame
+
+.. math::
+
+    a = A e_y, \qquad f = \frac{a \times b_T}{|a \times b_T|}, \qquad u = f \times a,
+    \qquad A_{ns} = [f, a, u]
+
+(b_T the track's up vector at the wheelset), so that yaw and roll of the wheelset enter and
+its spin does not.
+
+Forces
+------
+For every loaded contact c of a wheelset with centre r, the force on the wheel is
+F_c = N_c n_c + F_{x,c} t_c + F_{y,c} l_c at the wheel contact point p_c plus the spin moment
+M_{z,c} n_c (:class:`railway.forces.ContactForces`).  The generalized forces of the wheelset
+(Nikravesh 1988, Eq. 6.178; body-frame moment as core uses it):
+
+.. math::
+
+    Q_r = \sum_c F_c, \qquad
+    Q_\omega = A^T \sum_c \left[(p_c - r) \times F_c + M_{z,c} n_c\right],
+
+and, when the rails are mounted on a body R (``rail_body``), the reaction −F_c at the same point
+and −M_{z,c} n_c act on R.  The contact is then computed in R's frame: the track is defined in
+R's body coordinates and the wheelset's pose and velocities are taken relative to R,
+
+.. math::
+
+    r' = A_R^T (r - r_R), \quad A' = A_R^T A, \quad
+    v' = A_R^T (\dot r - \dot r_R - \omega_R \times (r - r_R)), \quad
+    \omega' = A_R^T (\omega - \omega_R),
+
+so that the creepages are the wheel's slip relative to the rail body's material.
+
+The search state, and why the force is a function of (t, q, v)
+--------------------------------------------------------------
+The contact search is an iteration; its start (the *seeds*) is the kind's search state, which
+follows core's rule (:mod:`core.forces.protocol`): :meth:`WheelRailKind.evaluate`,
+:meth:`~WheelRailKind.jacobian` and :meth:`~WheelRailKind.contact_outputs` read it and never
+change it, and it changes only in :meth:`~WheelRailKind.accept_step` (after accepted steps) and
+:meth:`~WheelRailKind.reset_state` (start of a run).  The state holds, per contact candidate,
+**two tracked stationary points** of the gap (the lowest and the next lowest distinct one) and
+the arc length s_n of each wheelset at the last accepted step.  An evaluation at (t, q, v):
+
+1. projects each wheelset centre on the track (Newton on (r − g(s))·g′(s) = 0 from s_n, to
+   1e-10 m: a function of q alone);
+2. runs the contact Newton iteration from both tracked points, their rail arc length moved by
+   s − s_n, to convergence, and keeps the lowest valid gap per candidate;
+3. turns the contacts into forces.
+
+So every evaluation within a step — Runge–Kutta stages, Newton iterates of the implicit
+integrators, rejected attempts and dense output — sees the same state and returns the same force
+at the same (t, q, v), bit for bit.  Across histories the force at (t, q, v) differs at most by
+the Newton tolerance of the search, as long as the history leaves the two lowest local minima of
+the gap in the two tracked points; a contact *jump* between these two minima within a step is
+found because both are iterated at every evaluation.  At each accepted step the tracked points
+are refreshed by a global scan of the cross-section (every ``reseed_every`` accepted steps,
+default 1, and whenever a tracked contact is lost), which is what finds a new minimum.
+
+Jacobians
+---------
+∂Q/∂q (along velocity-space increments: δr global, δθ in body axes, at fixed body-frame ω̄) and
+∂Q/∂v are central finite differences inside the kind, evaluated with the frozen search state
+(so the differenced function is smooth): the six pose directions of all wheelsets are perturbed
+together — a wheelset's force depends on its own pose only when the rails are the ground — so
+that a full Jacobian costs 12 searches whatever the number of wheelsets; with a rail body the
+wheelsets are perturbed one at a time.  Velocity columns only recompute the forces (the
+geometry does not depend on v).  Steps: 1e-7 m and rad for poses, 1e-6 m/s and rad/s for
+velocities.  ``tests/railway/test_wheel_rail.py`` measures them against the analytic
+linearisation of a wheelset on its rails (vertical Hertz stiffness 3/2 N/δ, lateral creep
+damping 2 f22/V, yaw creep damping 2 f11 l²/V).
+
+Loss of contact and derailment
+------------------------------
+A wheel that lifts off has no penetration and gets zero force.  After every accepted step the
+kind checks that every wheel still runs on its rail: a contact within ``flange_tip_margin`` of
+the flange tip (the flange has climbed onto the rail crown), or a wheelset whose lateral
+displacement exceeds ``max_lateral_displacement`` or whose centre sank more than
+``max_drop`` below its nominal height (it left the rail), ends the run with status ``failed``,
+the time, the wheel and its last Y/Q (the integrators catch the :class:`NumericalFailure` raised
+from ``accept_step``).
+
+References
+----------
+Pombo, J., Ambrósio, J. and Silva, M. (2007). A new wheel–rail contact model for railway
+dynamics. Vehicle System Dynamics 45(2):165–189.  Nikravesh, P. E. (1988). Computer-Aided
+Analysis of Mechanical Systems, Eq. 6.178.  Shabana, A. A., Zaazaa, K. E. and Sugiyama, H.
+(2008). Railroad Vehicle Dynamics: A Computational Approach, ch. 5 and 6.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from core import frames
+from core.errors import ModelError, NumericalFailure
+from core.forces.protocol import ForceElement, ForceEval, ForceJacobian, ForceKind
+
+from .contact_search import ContactSearch
+from .forces import ContactForces
+from .profiles import WheelProfile
+from .track import RailMounting
+
+__all__ = ["WheelRailContact", "WheelRailKind"]
+
+#: finite-difference steps of the Jacobian: poses (m, rad) and velocities (m/s, rad/s)
+FD_POSE, FD_VELOCITY = 1e-7, 1e-6
+
+
+@dataclass(frozen=True, eq=False)
+class WheelRailContact(ForceElement):
+    """Wheel–rail contact of a set of wheelsets on one track (a core force element).
+
+    Parameters
+    ----------
+    name : str
+    wheelsets : sequence of str
+        Names of the wheelset bodies (spatial; body y axis = axle towards the left wheel).
+    track : railway.track.Track
+        The track, in global coordinates (or in ``rail_body``'s body coordinates).
+    wheel : WheelProfile, optional
+        Default S1002 with r0 = 0.46 m.
+    rails : RailMounting or (RailMounting, RailMounting), optional
+        Default UIC60 inclined 1:40 at gauge 1435 mm.
+    flange_back_spacing : float
+        m, default 1.360.
+    creep_law : str, CreepModel or None
+        Any registered creep law (``"kalker_linear"``, ``"shen_hedrick_elkins"``,
+        ``"polach2000"``, ``"polach2005"``, ``"fastsim"``, ...); None: normal forces only (a
+        vehicle standing on its rails, e.g. the static preload).
+    creep_params : dict, optional
+        Parameters of the creep law (e.g. Polach 2005's ``k_A, k_S, A, B, speed``).
+    E, nu, mu : float
+        Young's modulus (Pa) and Poisson ratio of wheel and rail, friction coefficient.
+    restitution, approach_velocity_floor : float
+        Lankarani–Nikravesh damping (see :func:`railway.forces.lankarani_nikravesh_force`).
+    rail_body : str, optional
+        Body carrying the rails (default: the ground).
+    reseed_every : int
+        Global re-seeding of the tracked contacts every this many accepted steps (default 1).
+    flange_tip_margin, max_lateral_displacement, max_drop : float
+        Derailment criteria (m): contact within this distance of the flange tip; lateral
+        displacement of a wheelset from the track centre; drop of a wheelset centre below
+        its nominal height r0 above the rail tops.
+    """
+
+    name: str
+    wheelsets: Any
+    track: Any
+    wheel: Any = None
+    rails: Any = None
+    flange_back_spacing: float = 1.360
+    creep_law: Any = "kalker_linear"
+    creep_params: Any = None
+    E: float = 2.1e11
+    nu: float = 0.28
+    mu: float = 0.3
+    restitution: float = 0.9
+    approach_velocity_floor: float = 0.1
+    rail_body: Any = None
+    reseed_every: int = 1
+    flange_tip_margin: float = 1e-3
+    max_lateral_displacement: float = 0.05
+    max_drop: float = 0.03
+
+    @classmethod
+    def compile(cls, elements, ctx):
+        return WheelRailKind(elements, ctx)
+
+
+@dataclass
+class _State:
+    """Search state of one element (see the module docstring)."""
+
+    seeds: np.ndarray      # (2, P, 4) tracked stationary points (theta, y, s, u)
+    s_ws: np.ndarray       # (n_ws,) wheelset arc lengths at the last accepted step
+    valid: np.ndarray      # (P,) candidates with a contact (a valid stationary point) then
+    accepted: int = 0      # accepted steps since the run started
+    last_YQ: np.ndarray = field(default_factory=lambda: np.zeros(0))  # (n_wheels,) at the last accepted step
+
+
+class _Set:
+    """One WheelRailContact element compiled: bodies, search, forces and state."""
+
+    def __init__(self, e: WheelRailContact, ctx):
+        if ctx.space.dim != 3:
+            raise ModelError(f"wheel-rail contact {e.name!r}: needs a spatial model (ModelBuilder(3))")
+        names = [e.wheelsets] if isinstance(e.wheelsets, str) else list(e.wheelsets)
+        if not names:
+            raise ModelError(f"wheel-rail contact {e.name!r}: no wheelset bodies given")
+        if len(set(names)) != len(names):
+            raise ModelError(f"wheel-rail contact {e.name!r}: a wheelset body is listed twice: {names}")
+        self.name = e.name
+        self.bw = np.array([ctx.index(b, e.name) for b in names], np.int64)
+        self.ground = len(ctx.body_names) if hasattr(ctx, "body_names") else ctx.bs0.r.shape[0] - 1
+        if np.any(self.bw == self.ground):
+            raise ModelError(f"wheel-rail contact {e.name!r}: the ground cannot be a wheelset")
+        self.wheelset_names = names
+        self.rb = None if e.rail_body is None else ctx.index(e.rail_body, e.name)
+        if self.rb is not None and self.rb in set(self.bw.tolist()):
+            raise ModelError(f"wheel-rail contact {e.name!r}: rail body {e.rail_body!r} is also a wheelset")
+        self.track = e.track
+        wheel = e.wheel if e.wheel is not None else WheelProfile.s1002()
+        rails = e.rails if e.rails is not None else RailMounting()
+        for key in ("reseed_every",):
+            v = getattr(e, key)
+            if not (isinstance(v, (int, np.integer)) and v >= 1):
+                raise ModelError(f"wheel-rail contact {e.name!r}: {key} = {v!r} must be a positive integer")
+        for key in ("flange_tip_margin", "max_lateral_displacement", "max_drop"):
+            v = float(getattr(e, key))
+            if not (np.isfinite(v) and v > 0):
+                raise ModelError(f"wheel-rail contact {e.name!r}: {key} = {v!r} m must be positive")
+        self.e = e
+        self.cs = ContactSearch(e.track, wheel=wheel, rails=rails, n_wheelsets=len(names),
+                                flange_back_spacing=e.flange_back_spacing, n_seeds=2, tol=1e-11,
+                                tol_linear=1e-11)
+        try:
+            self.cf = ContactForces(E=e.E, nu=e.nu, mu=e.mu, creep_model=e.creep_law,
+                                    restitution=e.restitution,
+                                    approach_velocity_floor=e.approach_velocity_floor,
+                                    creep_params=e.creep_params)
+        except ValueError as exc:
+            raise ModelError(f"wheel-rail contact {e.name!r}: {exc}") from None
+        self.wheel = wheel
+        self.n_ws = len(names)
+        self.state: _State | None = None
+        # wheelsets must have their y axis along the track's lateral direction at build
+        r, A, _, _ = self.states(ctx.bs0)
+        s = self._project(r, None)
+        R = self.track.evaluate_raw(s)[3]
+        cos_axle = np.abs(np.einsum("ni,ni->n", A[:, :, 1], R[:, :, 1]))
+        if np.any(cos_axle < 0.9):
+            k = int(np.argmin(cos_axle))
+            raise ModelError(f"wheel-rail contact {e.name!r}: wheelset {names[k]!r} has its body y axis "
+                             f"at {np.degrees(np.arccos(min(cos_axle[k], 1.0))):.1f} deg from the track's "
+                             "lateral direction; the body y axis must be the axle")
+
+    # ---------------------------------------------------------------------------------------
+    def states(self, bs):
+        """Wheelset centre, rotation, velocity and global angular velocity, in the rail frame."""
+        r, A = bs.r[self.bw], bs.A[self.bw]
+        v = bs.rdot[self.bw]
+        w = np.einsum("nij,nj->ni", A, bs.w[self.bw])  # global angular velocity
+        if self.rb is None:
+            return r, A, v, w
+        rR, AR = bs.r[self.rb], bs.A[self.rb]
+        wR = AR @ bs.w[self.rb]
+        d = r - rR
+        return (d @ AR, np.einsum("ji,njk->nik", AR, A),
+                (v - bs.rdot[self.rb] - np.cross(wR, d)) @ AR, (w - wR) @ AR)
+
+    def _project(self, r, s_guess):
+        """Track arc length of the wheelset centres: Newton from ``s_guess`` (the last accepted
+        step's), or from the nearest node of the track's frame table when there is no guess or
+        the iteration from the guess does not converge (e.g. a wild Newton iterate of an
+        implicit integrator)."""
+        if s_guess is not None:
+            try:
+                return self.track.project(r, s_guess)
+            except NumericalFailure:
+                pass
+        nodes = self.track.frame_table.nodes
+        pos = self.track.evaluate_raw(nodes)[0]
+        guess = nodes[np.argmin(np.linalg.norm(pos[None, :, :] - r[:, None, :], axis=2), axis=1)]
+        try:
+            s = self.track.project(r, guess)
+        except NumericalFailure:  # point by point; NaN where a wheelset is nowhere near the track
+            s = np.full(r.shape[0], np.nan)
+            for k in range(r.shape[0]):
+                try:
+                    s[k] = self.track.project(r[k:k + 1], guess[k:k + 1])[0]
+                except NumericalFailure:
+                    pass
+        if not getattr(self.track, "closed", False):  # beyond the ends of an open track: no rail
+            s = np.where((s >= 0.0) & (s <= self.track.length), s, np.nan)
+        return s
+
+    def unspun(self, A, s):
+        """Wheelset frames without the spin: [f, a, u] (module docstring)."""
+        up = self.track.evaluate_raw(s)[3][:, :, 2]
+        a = A[:, :, 1]
+        f = np.cross(a, up)
+        f /= np.linalg.norm(f, axis=1)[:, None]
+        return np.stack([f, a, np.cross(f, a)], axis=2)
+
+    def pairs(self, s):
+        """The (seed, problem) pairs an evaluation iterates: both tracked points of every
+        candidate that had a contact at the last accepted step (the second only where it is a
+        distinct stationary point), their rail arc length moved with the wheelsets."""
+        seeds = self.predicted_seeds(s)
+        act = self.state.valid
+        distinct = act & (np.abs(seeds[1, :, 1] - seeds[0, :, 1]) > 1e-9)
+        P = act.size
+        prob = np.concatenate([np.flatnonzero(act), np.flatnonzero(distinct)])
+        x0 = np.concatenate([seeds[0][act], seeds[1][distinct]])
+        order = np.argsort(prob, kind="stable")
+        return x0[order], prob[order] if P else prob
+
+    def accept_pairs(self, r, Ans, s, reseed):
+        """The accepted step's search: both tracked points of the candidates that had a contact
+        and, when re-seeding, the two best scan seeds of every candidate where the scan found a
+        stationary point near (a sign change of the fourth condition); returns (res, X, G,
+        problem) with the Newton solution and gap of every pair."""
+        x0, prob = self.pairs(s)
+        if reseed:
+            scan = self.cs.scan_seeds(r, Ans, s, ranks=2)
+            extra = [(q[q[:, 4] > 0.5, :4], np.flatnonzero(q[:, 4] > 0.5)) for q in scan]
+            x0 = np.concatenate([x0] + [a for a, _ in extra])
+            prob = np.concatenate([prob] + [b for _, b in extra])
+            order = np.argsort(prob, kind="stable")
+            x0, prob = x0[order], prob[order]
+        res, X, G = self.cs.solve_pairs(x0, prob, r, Ans, s)
+        return res, X, G, prob
+
+    def predicted_seeds(self, s):
+        """The tracked points with their rail arc length moved with the wheelsets."""
+        st = self.state
+        seeds = st.seeds.copy()
+        ws = self.cs._problems["ws"]
+        seeds[:, :, 2] += (s - st.s_ws)[ws][None, :]
+        return seeds
+
+    def contacts(self, r, A, v, w, s=None):
+        """(res, forces, s, Ans): contacts from the frozen state and their forces.
+
+        A wheelset that is not over the track (no projection, or beyond the ends of an open
+        track: s is NaN) has no contact; it is searched at its last accepted arc length, and its
+        contacts are marked invalid (zero force).
+        """
+        s = self._project(r, self.state.s_ws) if s is None else s
+        off = ~np.isfinite(s)
+        if np.any(off):
+            s = np.where(off, self.state.s_ws, s)
+        Ans = self.unspun(A, s)
+        x0, prob = self.pairs(s)
+        res = self.cs.solve_pairs(x0, prob, r, Ans, s)[0]
+        if np.any(off):
+            gone = np.repeat(off, 2)
+            res.valid[gone] = False
+            res.in_contact[gone] = False
+            res.gap[gone] = np.inf
+            res.penetration[gone] = -np.inf
+        f = self.cf(res, r, Ans, v, w)
+        return res, f, np.where(off, np.nan, s), Ans
+
+    def generalized(self, r, A_body, res, f):
+        """Q of the wheelsets (n_ws, 6) in rail-frame components (rotation part in body axes)."""
+        valid = res.valid[..., None]
+        p = np.where(valid, res.point_wheel, 0.0).reshape(self.n_ws, 4, 3)
+        F = f["force"].reshape(self.n_ws, 4, 3)
+        M = f["moment"].reshape(self.n_ws, 4, 3)
+        arm = np.where(valid.reshape(self.n_ws, 4, 1), p - r[:, None, :], 0.0)
+        Ft = F.sum(axis=1)
+        Mt = (np.cross(arm, F) + M).sum(axis=1)
+        return Ft, Mt, p, F, M
+
+    def rhs(self, bs, s=None):
+        """Generalized forces: list of (bodies, Qb) blocks."""
+        r, A, v, w = self.states(bs)
+        res, f, _, _ = self.contacts(r, A, v, w, s)
+        Ft, Mt, p, F, M = self.generalized(r, A, res, f)
+        if self.rb is None:
+            Qw = np.concatenate([Ft, np.einsum("nji,nj->ni", A, Mt)], axis=1)
+            return self.bw, Qw
+        AR, rR = bs.A[self.rb], bs.r[self.rb]
+        Ag = bs.A[self.bw]  # actual body rotations (global)
+        Ftg, Mtg = Ft @ AR.T, Mt @ AR.T
+        Qw = np.concatenate([Ftg, np.einsum("nji,nj->ni", Ag, Mtg)], axis=1)
+        # reaction on the rail body: -F at the contact points, -M
+        pg = p @ AR.T + rR  # (n_ws, 4, 3) global contact points (zero-force where invalid)
+        Fg = F @ AR.T
+        Mg = M @ AR.T
+        FR = -Fg.sum(axis=(0, 1))
+        MR = -(np.cross(pg - rR, Fg) + Mg).sum(axis=(0, 1))
+        QR = np.concatenate([FR, AR.T @ MR])[None, :]
+        return np.concatenate([self.bw, [self.rb]]), np.concatenate([Qw, QR])
+
+
+class WheelRailKind(ForceKind):
+    """All :class:`WheelRailContact` elements of a model (module docstring)."""
+
+    stateful = True
+    conservative = False
+
+    def __init__(self, elements, ctx):
+        self.names = [e.name for e in elements]
+        self.sets = [_Set(e, ctx) for e in elements]
+        self._n_v = ctx.space.n_v
+
+    # --- forces ----------------------------------------------------------------------------
+    def _require_state(self, bs, t):
+        for st in self.sets:
+            if st.state is None:  # evaluated outside a run (analyses): start from this pose
+                st.state = self._fresh_state(st, bs)
+
+    def evaluate(self, bs, t):
+        self._require_state(bs, t)
+        blocks = [st.rhs(bs) for st in self.sets]
+        return ForceEval(np.concatenate([b for b, _ in blocks]), np.concatenate([q for _, q in blocks]))
+
+    def jacobian(self, bs, t):
+        """Central differences with the frozen search state (module docstring)."""
+        self._require_state(bs, t)
+        blocks: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = {}
+        for st in self.sets:
+            # all wheelsets at once when the rails are the ground (no coupling between them)
+            groups = ([st.bw] if st.rb is None
+                      else [np.array([b]) for b in list(st.bw) + [st.rb]])
+            for g in groups:
+                for k in range(6):
+                    (bq, Qp), (_, Qm) = (st.rhs(_perturbed_pose(bs, g, k, h)) for h in (FD_POSE, -FD_POSE))
+                    (_, Vp), (_, Vm) = (st.rhs(_perturbed_velocity(bs, g, k, h))
+                                        for h in (FD_VELOCITY, -FD_VELOCITY))
+                    dq = (Qp - Qm) / (2.0 * FD_POSE)
+                    dv = (Vp - Vm) / (2.0 * FD_VELOCITY)
+                    for m, body in enumerate(bq):
+                        if st.rb is None:
+                            col = int(body)  # block diagonal
+                        else:
+                            col = int(g[0])
+                        Kq, Kv = blocks.setdefault((int(body), col), (np.zeros((6, 6)), np.zeros((6, 6))))
+                        Kq[:, k] += dq[m]
+                        Kv[:, k] += dv[m]
+        keys = list(blocks)
+        return ForceJacobian(np.array([a for a, _ in keys], np.int64), np.array([b for _, b in keys], np.int64),
+                             np.array([blocks[key][0] for key in keys]), np.array([blocks[key][1] for key in keys]))
+
+    # --- search state ----------------------------------------------------------------------
+    def _fresh_state(self, st, bs):
+        r, A, v, w = st.states(bs)
+        s = st._project(r, None)
+        if not np.all(np.isfinite(s)):
+            k = int(np.argmax(~np.isfinite(s)))
+            raise ModelError(f"wheel-rail contact {st.name!r}: wheelset {st.wheelset_names[k]!r} at "
+                             f"{r[k].round(3).tolist()} m is not over the track")
+        Ans = st.unspun(A, s)
+        scan = st.cs.scan_seeds(r, Ans, s, ranks=4)
+        res, X, G, xb = st.cs.solve([q[:, :4] for q in scan], r, Ans, s, scan_out=scan)
+        return _State(seeds=_two_lowest(xb, X, G), s_ws=s, valid=res.valid.ravel().copy(),
+                      accepted=0, last_YQ=np.full(2 * st.n_ws, np.nan))
+
+    def reset_state(self, bs, t):
+        for st in self.sets:
+            st.state = self._fresh_state(st, bs)
+
+    def accept_step(self, bs, t):
+        for st in self.sets:
+            state = st.state
+            if state is None:
+                st.state = self._fresh_state(st, bs)
+                continue
+            r, A, v, w = st.states(bs)
+            s = st._project(r, state.s_ws)
+            if not np.all(np.isfinite(s)):
+                k = int(np.argmax(~np.isfinite(s)))
+                raise NumericalFailure(
+                    f"wheelset {st.wheelset_names[k]!r} ({st.name}) is no longer over the track (beyond "
+                    f"the end of the track or far off the rails, at {r[k].round(3).tolist()} m)")
+            Ans = st.unspun(A, s)
+            reseed = (state.accepted + 1) % st.e.reseed_every == 0
+            res, X, G, prob = st.accept_pairs(r, Ans, s, reseed)
+            if not reseed and np.any(state.valid & ~res.valid.ravel()):  # a tracked contact was lost
+                res, X, G, prob = st.accept_pairs(r, Ans, s, True)
+            f = st.cf(res, r, Ans, v, w)
+            out = _wheel_quantities(st, res, f, r, Ans, s, w)
+            _check_derailment(st, res, out, state.last_YQ)
+            xb = np.column_stack([res.theta.ravel(), res.y_wheel.ravel(), res.s_rail.ravel(), res.u_rail.ravel()])
+            st.state = _State(seeds=_two_lowest_pairs(xb, res.valid.ravel(), X, G, prob, state.seeds),
+                              s_ws=s, valid=res.valid.ravel().copy(), accepted=state.accepted + 1,
+                              last_YQ=out["wheels"]["Y/Q [-]"].copy())
+
+    # --- outputs ---------------------------------------------------------------------------
+    def outputs(self, bs, t):
+        """Per element: the largest Y/Q and the smallest wheel load of its wheels."""
+        self._require_state(bs, t)
+        yq, qmin = [], []
+        for st in self.sets:
+            out = self.contact_outputs(bs, t, st.name)
+            yq.append(np.nanmax(out["wheels"]["Y/Q [-]"], initial=-np.inf))
+            qmin.append(np.min(out["wheels"]["Q [N]"]))
+        return {"max Y/Q [-]": np.array(yq), "min Q [N]": np.array(qmin)}
+
+    def contact_outputs(self, bs, t, element=None):
+        """What a railway engineer reads per wheel and per contact at (t, q, v).
+
+        Returns
+        -------
+        dict
+            ``"wheels"``: dict of arrays (n_wheels,) (see :func:`_wheel_quantities`);
+            ``"contacts"``: dict of arrays (n_wheels, 2) per candidate (tread, flange);
+            ``"wheelsets"``: dict of arrays (n_ws,).
+        """
+        self._require_state(bs, t)
+        st = self._set(element)
+        r, A, v, w = st.states(bs)
+        res, f, s, Ans = st.contacts(r, A, v, w)
+        return _wheel_quantities(st, res, f, r, Ans, s, w)
+
+    # --- compiled path -----------------------------------------------------------------------
+    def compiled(self, layout):
+        """Kernels for core's compiled integrators (:mod:`railway.wheel_rail_compiled`)."""
+        from .wheel_rail_compiled import compile_wheel_rail
+
+        return compile_wheel_rail(self, layout)
+
+    def _set(self, element):
+        if element is None:
+            return self.sets[0]
+        for st in self.sets:
+            if st.name == element:
+                return st
+        raise ModelError(f"no wheel-rail contact element {element!r}; there are {self.names}")
+
+
+# ------------------------------------------------------------------------------------------
+def _two_lowest_pairs(xb, valid, X, G, prob, old, distinct=1e-4):
+    """Tracked points (2, P, 4) after an accepted step: per candidate the solution ``xb`` and the
+    lowest other pair solution at least ``distinct`` (m) away in the wheel profile coordinate
+    (else ``xb`` again); candidates without a contact keep their old tracked points."""
+    P = xb.shape[0]
+    first = np.where(valid[:, None], xb, old[0])
+    second = first.copy()
+    far = np.abs(X[:, 1] - xb[prob, 1]) > distinct
+    g = np.where(far & np.isfinite(G), G, np.inf)
+    if g.size:
+        order = np.lexsort((np.arange(g.size), g, prob))
+        firstk = order[np.r_[True, prob[order][1:] != prob[order][:-1]]]
+        ok = np.isfinite(g[firstk]) & valid[prob[firstk]]
+        second[prob[firstk][ok]] = X[firstk][ok]
+    return np.stack([first, second])
+
+
+def _two_lowest(xb, X, G, distinct=1e-4):
+    """Tracked points (2, P, 4): the best solution and the lowest other stationary point at
+    least ``distinct`` (m) away in the wheel profile coordinate (else the best again)."""
+    m, P, _ = X.shape
+    second = xb.copy()
+    far = np.abs(X[:, :, 1] - xb[None, :, 1]) > distinct
+    Gf = np.where(far & np.isfinite(G), G, np.inf)
+    j = np.argmin(Gf, axis=0)
+    has = np.isfinite(Gf[j, np.arange(P)])
+    second[has] = X[j[has], np.arange(P)[has]]
+    first = np.where(np.all(np.isfinite(xb), axis=1)[:, None], xb, X[0])
+    return np.stack([first, second])
+
+
+def _perturbed_pose(bs, bodies, k, h):
+    """Body states with the pose of ``bodies`` moved by h along velocity-space direction k
+    (translation k < 3 global; rotation k >= 3 about body axis k - 3), velocities unchanged."""
+    from core.bodies import BodyStates
+
+    r, A = bs.r.copy(), bs.A.copy()
+    if k < 3:
+        r[bodies, k] += h
+    else:
+        e = np.zeros(3)
+        e[k - 3] = h
+        A[bodies] = A[bodies] @ frames.euler_to_matrix(frames.rotation_vector_to_euler(e))
+    return BodyStates(bs.space, r, A, bs.rdot, bs.w, bs.x, bs.xdot)
+
+
+def _perturbed_velocity(bs, bodies, k, h):
+    from core.bodies import BodyStates
+
+    rd, w = bs.rdot.copy(), bs.w.copy()
+    if k < 3:
+        rd[bodies, k] += h
+    else:
+        w[bodies, k - 3] += h
+    return BodyStates(bs.space, bs.r, bs.A, rd, w, bs.x, bs.xdot)
+
+
+def _wheel_quantities(st, res, f, r, Ans, s, w):
+    """Per-wheel Q, Y, Y/Q and friends from contacts and forces (rail-frame quantities).
+
+    Conventions: Q is the vertical force of the wheel on the rail (track up axis, positive
+    downwards on the rail); Y the lateral force of the wheel on the rail, positive towards the
+    field side of that rail (outwards), so that Y/Q > 0 on a flange-climbing wheel; the
+    wheelset's ΣY is the lateral force of the axle on the track in the track's lateral axis
+    (positive to the left).
+    """
+    try:
+        from .assessment import max_pressure, nadal_limit, wear_number
+    except ImportError:  # TEMPORARY until railway.assessment lands
+        def max_pressure(N, a, b):
+            return 1.5 * N / (np.pi * a * b)
+
+        def nadal_limit(g, mu):
+            return (np.tan(g) - mu) / (1 + mu * np.tan(g))
+
+        def wear_number(Fx, Fy, xi, eta):
+            return np.abs(Fx * xi) + np.abs(Fy * eta)
+
+    n_ws = st.n_ws
+    fr = st.track.evaluate_raw(s)
+    pos, R = fr[0], fr[3]
+    t_tr, lat, up = R[:, :, 0], R[:, :, 1], R[:, :, 2]
+    Fw = f["force"].reshape(n_ws, 2, 2, 3)  # on the wheel
+    side = np.array([1.0, -1.0])
+    Fsum = Fw.sum(axis=2)  # per wheel
+    Q = np.einsum("nsk,nk->ns", Fsum, up)
+    Ylat = -np.einsum("nsk,nk->ns", Fsum, lat)  # wheel on rail, track lateral (left +)
+    Y = Ylat * side[None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        YQ = np.where(Q > 0, Y / Q, np.nan)
+    N = f["N"].reshape(n_ws, 2, 2)
+    loaded = N > 0
+    gam = np.where(res.valid, res.contact_angle, np.nan).reshape(n_ws, 2, 2)
+    # the flange contact of a wheel: the loaded candidate with the larger contact angle
+    gmax = np.where(loaded, gam, -np.inf).max(axis=2)
+    flange = loaded.any(axis=2) & (gmax > np.radians(45.0))
+    lim = np.where(flange, nadal_limit(np.where(np.isfinite(gmax), gmax, 0.0), st.e.mu), np.nan)
+    a, b = f["a"].reshape(n_ws, 2, 2), f["b"].reshape(n_ws, 2, 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pmax = np.where(loaded, max_pressure(N, a, b), 0.0)
+    Tg = wear_number(f["Fx"], f["Fy"], f["xi"], f["eta"]).reshape(n_ws, 2, 2)
+    d = r - pos
+    y_ws = np.einsum("nk,nk->n", d, lat)
+    z_ws = np.einsum("nk,nk->n", d, up)
+    fwd = Ans[:, :, 0]
+    yaw = np.arctan2(np.einsum("nk,nk->n", fwd, lat), np.einsum("nk,nk->n", fwd, t_tr))
+    spin = np.einsum("nk,nk->n", w, Ans[:, :, 1])
+    out = {
+        "Q [N]": Q.ravel(), "Y [N]": Y.ravel(), "Y/Q [-]": YQ.ravel(),
+        "flange contact": flange.ravel(), "flange force [N]": np.where(flange, N.max(axis=2), 0.0).ravel(),
+        "Nadal limit [-]": lim.ravel(), "contact angle [rad]": np.where(np.isfinite(gmax), gmax, np.nan).ravel(),
+        "p_max [Pa]": pmax.max(axis=2).ravel(), "T gamma [N]": Tg.sum(axis=2).ravel(),
+        "y_wheel [m]": res.y_wheel.reshape(n_ws, 2, 2)[..., 0].ravel(),
+        "flange tip distance [m]": _tip_distance(st, res).ravel(),
+    }
+    contacts = {
+        "N [N]": N, "Fx [N]": f["Fx"].reshape(n_ws, 2, 2), "Fy [N]": f["Fy"].reshape(n_ws, 2, 2),
+        "Mz [N m]": f["Mz"].reshape(n_ws, 2, 2), "xi [-]": f["xi"].reshape(n_ws, 2, 2),
+        "eta [-]": f["eta"].reshape(n_ws, 2, 2), "phi [1/m]": f["phi"].reshape(n_ws, 2, 2),
+        "a [m]": a, "b [m]": b, "p_max [Pa]": pmax, "T gamma [N]": Tg, "contact angle [rad]": gam,
+        "penetration [m]": np.where(res.valid, res.penetration, np.nan).reshape(n_ws, 2, 2),
+        "y_wheel [m]": res.y_wheel.reshape(n_ws, 2, 2), "u_rail [m]": res.u_rail.reshape(n_ws, 2, 2),
+        "rolling radius [m]": res.rolling_radius.reshape(n_ws, 2, 2),
+    }
+    wheelsets = {
+        "s [m]": s, "lateral displacement [m]": y_ws, "height [m]": z_ws, "angle of attack [rad]": yaw,
+        "spin [rad/s]": spin, "sum Y [N]": Ylat.sum(axis=1),
+    }
+    return {"wheels": out, "contacts": {k: v.reshape(2 * n_ws, 2) for k, v in contacts.items()},
+            "wheelsets": wheelsets}
+
+
+def _tip_distance(st, res):
+    """Distance (m) of each wheel's flange-candidate contact from the flange tip, along the
+    profile coordinate (inf where the flange candidate has no contact)."""
+    yf = res.y_wheel[:, 1]
+    loaded = res.valid[:, 1] & (res.penetration[:, 1] > 0)
+    return np.where(loaded, yf - st.wheel.y_tip, np.inf)
+
+
+def _check_derailment(st, res, out, last_YQ):
+    """NumericalFailure naming the wheel when a wheel left its rail (module docstring)."""
+    e = st.e
+    labels = [f"{ws} {side}" for ws in st.wheelset_names for side in ("left", "right")]
+    wh, wss = out["wheels"], out["wheelsets"]
+    yq = wh["Y/Q [-]"]
+
+    def last(i):
+        v = last_YQ[i] if last_YQ.size else np.nan
+        return f"last Y/Q {v:.3g} at the previous accepted step, {yq[i]:.3g} now"
+
+    tip = wh["flange tip distance [m]"]
+    if np.any(tip < e.flange_tip_margin):
+        i = int(np.argmin(tip))
+        raise NumericalFailure(
+            f"derailment of wheel {labels[i]!r} ({e.name}): its flange contact is {tip[i] * 1e3:.2f} mm "
+            f"from the flange tip (the flange climbed onto the rail; criterion "
+            f"{e.flange_tip_margin * 1e3:g} mm); {last(i)}")
+    y = wss["lateral displacement [m]"]
+    drop = st.wheel.r0 - wss["height [m]"]
+    bad = (np.abs(y) > e.max_lateral_displacement) | (drop > e.max_drop)
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        i = 2 * k + (0 if y[k] > 0 else 1)  # the wheel on the side it moved to
+        raise NumericalFailure(
+            f"derailment of wheelset {st.wheelset_names[k]!r} ({e.name}): it left the rails "
+            f"(lateral displacement {y[k] * 1e3:.1f} mm, limit {e.max_lateral_displacement * 1e3:g} mm; "
+            f"centre {drop[k] * 1e3:.1f} mm below its nominal height, limit {e.max_drop * 1e3:g} mm); "
+            f"wheel {labels[i]!r}: {last(i)}")

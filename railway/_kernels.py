@@ -20,7 +20,7 @@ except ImportError:  # pragma: no cover - exercised only without numba
     numba = None
     HAVE_NUMBA = False
 
-__all__ = ["HAVE_NUMBA", "newton_kernel", "scan_kernel"]
+__all__ = ["HAVE_NUMBA", "newton_kernel", "scan_kernel", "reduced_min_kernel"]
 
 
 # The kernels are module-level functions (inside this ``if``), not closures: numba's on-disk
@@ -360,6 +360,160 @@ if HAVE_NUMBA:
 
 
 
+    @njit
+    def _reduced_gap(x, sig, r0, L, ow, orr, Y0, Z0, ca, sa, rws, A, b_inner, b_breaks, b_stack,
+                     f_inner, f_breaks, f_stack, lo, hi, maxstep, buf):
+        """psi(y): solve h1 = h3 = h4 = 0 for (theta, s, u) at the wheel profile coordinate
+        x[1] (x updated in place, warm start); returns the gap d . n, +inf when the 3x3
+        Newton does not converge or leaves the rail's range (ContactSearch._reduced)."""
+        h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal, W, o = buf
+        M = np.empty((3, 4))
+        for it in range(14):
+            evaluate(x, sig, r0, L, ow, orr, Y0, Z0, ca, sa, rws, A, b_inner, b_breaks, b_stack,
+                     f_inner, f_breaks, f_stack, h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R,
+                     scal, W, o)
+            if abs(h[0]) < 1e-12 and abs(h[2]) < 1e-13 and abs(h[3]) < 1e-13:
+                break
+            k3 = (0, 2, 3)
+            for a in range(3):
+                for b in range(3):
+                    M[a, b] = J[k3[a], k3[b]]
+                M[a, 3] = -h[k3[a]]
+            ok = True
+            for c in range(3):  # Gaussian elimination with partial pivoting
+                piv = c
+                for rr in range(c + 1, 3):
+                    if abs(M[rr, c]) > abs(M[piv, c]):
+                        piv = rr
+                if abs(M[piv, c]) < 1e-300:
+                    ok = False
+                    break
+                if piv != c:
+                    for k in range(4):
+                        tmp = M[c, k]
+                        M[c, k] = M[piv, k]
+                        M[piv, k] = tmp
+                for rr in range(c + 1, 3):
+                    f = M[rr, c] / M[c, c]
+                    for k in range(c, 4):
+                        M[rr, k] -= f * M[c, k]
+            if not ok:
+                return np.inf
+            dx = np.empty(3)
+            for c in range(2, -1, -1):
+                acc = M[c, 3]
+                for k in range(c + 1, 3):
+                    acc -= M[c, k] * dx[k]
+                dx[c] = acc / M[c, c]
+            scale = 1.0
+            for a in range(3):
+                if not np.isfinite(dx[a]):
+                    return np.inf
+                lim = maxstep[k3[a]]
+                if abs(dx[a]) * scale > lim:
+                    scale = lim / abs(dx[a])
+            for a in range(3):
+                k = k3[a]
+                v = x[k] + scale * dx[a]
+                x[k] = min(max(v, lo[k]), hi[k])
+        if not (abs(h[0]) < 1e-9 and abs(h[2]) < 1e-10 and abs(h[3]) < 1e-10):
+            return np.inf
+        if not (x[3] > lo[3] and x[3] < hi[3]):
+            return np.inf
+        g = d[0] * n[0] + d[1] * n[1] + d[2] * n[2]
+        return g if np.isfinite(g) else np.inf
+
+    @njit
+    def reduced_min(x0, ylo, yhi, sig, r0, L, ow, orr, Y0, Z0, ca, sa, lo, hi, rws, A,
+                    b_inner, b_breaks, b_stack, f_inner, f_breaks, f_stack, maxstep,
+                    n_sample, tol):
+        """Robust contact per problem: the minimum of the gap psi(y) of the wheel profile line y
+        over [ylo, yhi] (n_sample samples, warm-started from one to the next, then golden-section
+        search between the neighbours of the lowest sample to ``tol`` on y).  For contacts where
+        Newton on the four conditions does not converge: a stationary point at a joint of
+        profile sections (slope step) or a nearly conformal contact (ContactSearch._robust).
+        Returns X (P, 4) and ok (P,)."""
+        P = x0.shape[0]
+        X = x0.copy()
+        ok = np.zeros(P, dtype=np.bool_)
+        buf = (np.empty(4), np.empty((4, 4)), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
+               np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
+               np.empty((2, 3)), np.empty((3, 3)), np.empty(5), np.empty((12, 3)),
+               np.empty(f_stack.shape[2]))
+        xs = np.empty(4)
+        xbest = np.empty(4)
+        gr = 0.5 * (np.sqrt(5.0) - 1.0)
+        for pi in range(P):
+            for k in range(4):
+                xs[k] = x0[pi, k]
+            gbest = np.inf
+            ibest = -1
+            ys = np.empty(n_sample)
+            for j in range(n_sample):
+                ys[j] = ylo[pi] + (yhi[pi] - ylo[pi]) * j / (n_sample - 1)
+                xs[3] += ys[j] - xs[1]
+                xs[1] = ys[j]
+                g = _reduced_gap(xs, sig[pi], r0[pi], L[pi], ow[pi], orr[pi], Y0[pi], Z0[pi], ca[pi],
+                                 sa[pi], rws[pi], A[pi], b_inner, b_breaks, b_stack, f_inner, f_breaks,
+                                 f_stack, lo[pi], hi[pi], maxstep, buf)
+                if g < gbest:
+                    gbest, ibest = g, j
+                    for k in range(4):
+                        xbest[k] = xs[k]
+                if not np.isfinite(g):  # restart the warm start from the seed
+                    for k in range(4):
+                        xs[k] = x0[pi, k]
+            if ibest < 0:
+                continue
+            a = ys[max(ibest - 1, 0)]
+            b = ys[min(ibest + 1, n_sample - 1)]
+            c = b - gr * (b - a)
+            dd = a + gr * (b - a)
+            xc = xbest.copy()
+            xc[3] += c - xc[1]
+            xc[1] = c
+            fc = _reduced_gap(xc, sig[pi], r0[pi], L[pi], ow[pi], orr[pi], Y0[pi], Z0[pi], ca[pi], sa[pi],
+                              rws[pi], A[pi], b_inner, b_breaks, b_stack, f_inner, f_breaks, f_stack,
+                              lo[pi], hi[pi], maxstep, buf)
+            xd = xbest.copy()
+            xd[3] += dd - xd[1]
+            xd[1] = dd
+            fdd = _reduced_gap(xd, sig[pi], r0[pi], L[pi], ow[pi], orr[pi], Y0[pi], Z0[pi], ca[pi], sa[pi],
+                               rws[pi], A[pi], b_inner, b_breaks, b_stack, f_inner, f_breaks, f_stack,
+                               lo[pi], hi[pi], maxstep, buf)
+            while b - a > tol:
+                if fc <= fdd:  # the minimum lies in [a, d]
+                    b, dd, fdd = dd, c, fc
+                    for k in range(4):
+                        xd[k] = xc[k]
+                    c = b - gr * (b - a)
+                    xc[3] += c - xc[1]
+                    xc[1] = c
+                    fc = _reduced_gap(xc, sig[pi], r0[pi], L[pi], ow[pi], orr[pi], Y0[pi], Z0[pi], ca[pi],
+                                      sa[pi], rws[pi], A[pi], b_inner, b_breaks, b_stack, f_inner, f_breaks,
+                                      f_stack, lo[pi], hi[pi], maxstep, buf)
+                else:
+                    a, c, fc = c, dd, fdd
+                    for k in range(4):
+                        xc[k] = xd[k]
+                    dd = a + gr * (b - a)
+                    xd[3] += dd - xd[1]
+                    xd[1] = dd
+                    fdd = _reduced_gap(xd, sig[pi], r0[pi], L[pi], ow[pi], orr[pi], Y0[pi], Z0[pi], ca[pi],
+                                       sa[pi], rws[pi], A[pi], b_inner, b_breaks, b_stack, f_inner,
+                                       f_breaks, f_stack, lo[pi], hi[pi], maxstep, buf)
+            if min(fc, fdd) < gbest:
+                src = xc if fc <= fdd else xd
+                for k in range(4):
+                    xbest[k] = src[k]
+            for k in range(4):
+                X[pi, k] = xbest[k]
+            # a minimum at the end of the interval is no contact of this zone (the gap keeps
+            # falling beyond it: the neighbouring zone holds the contact)
+            ok[pi] = ylo[pi] + 1e-7 < xbest[1] < yhi[pi] - 1e-7
+        return X, ok
+
+
 def scan_kernel():
     """The compiled seed scan (compiled on first use), or None without numba."""
     return scan if HAVE_NUMBA else None
@@ -368,3 +522,8 @@ def scan_kernel():
 def newton_kernel():
     """The compiled Newton kernel (compiled on first use), or None without numba."""
     return newton if HAVE_NUMBA else None
+
+
+def reduced_min_kernel():
+    """The compiled robust minimisation of the profile-line gap, or None without numba."""
+    return reduced_min if HAVE_NUMBA else None

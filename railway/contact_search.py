@@ -1006,7 +1006,7 @@ class ContactSearch:
         return self._multistart(x0, pc, r_ws[ws], A[ws], False, 0, max_iter=max_iter,
                                 scan_out=scan_out, return_all=True)
 
-    def solve_pairs(self, x0, problem, r_ws, A, s_ws):
+    def solve_pairs(self, x0, problem, r_ws, A, s_ws, robust=None, n_sample=96):
         """Contacts from explicit (seed, problem) pairs, without any state.
 
         Newton runs from every seed ``x0[k]`` (K, 4) for the problem ``problem[k]`` (an index
@@ -1015,6 +1015,12 @@ class ContactSearch:
         whose pairs all fail, have no contact (``valid`` False).  Cheaper than :meth:`solve` on
         trajectories, where only the candidates that had a contact at the last accepted step
         need iterating (no robust refinement here: that is :meth:`solve` with scan seeds).
+
+        ``robust`` (P,) bool: problems that, when no pair gives them a valid contact, are
+        refined by the robust minimisation of the profile-line gap over their whole zone
+        (:func:`railway._kernels.reduced_min`, ``n_sample`` samples then golden-section search):
+        a contact at the joint of two profile sections or a nearly conformal one, where Newton
+        on the four conditions does not converge.
 
         Returns
         -------
@@ -1051,8 +1057,46 @@ class ContactSearch:
             for key in info:
                 info[key][p] = gsv[key][first]
         x = np.where(np.isnan(x), pc["lo"].clip(-1.0, 1.0), x)  # placeholders of problems without pairs
+        if robust is not None:
+            g_best = np.where(conv, info["gap"], np.inf)
+            ok_best = conv & np.all((x > pc["lo_e"]) & (x < pc["hi_e"]), axis=1) & (g_best > -self.max_penetration)
+            todo = np.flatnonzero(np.asarray(robust, bool) & ~ok_best)
+            if todo.size:
+                xr, Hr, cr, infr = self._robust_zone(todo, x, r_ws, A, n_sample)
+                x[todo], H0[todo], conv[todo] = xr, Hr, cr
+                for key in info:
+                    info[key][todo] = infr[key]
         res = self._finish(x, H0, conv, pc, info, it)
         return res, xk, gk
+
+    def _robust_zone(self, todo, x, r_ws, A, n_sample):
+        """Robust minimisation of the profile-line gap over the whole zone of problems ``todo``
+        (compiled kernel; outputs at the minimum by one Newton evaluation).  Returns x, H,
+        conv, info (gap, S, V) for those problems."""
+        from ._kernels import reduced_min_kernel
+
+        pc = self._problems
+        ws = pc["ws"][todo]
+        pct = {k: (v[todo] if isinstance(v, np.ndarray) else v) for k, v in pc.items()}
+        x0 = x[todo].copy()
+        # a start inside the zone: theta from the current x (finite), s the wheelset's arc length
+        kern = reduced_min_kernel()
+        if kern is None:  # numpy fallback: the bracketed robust route over the zone
+            X, H, conv, info, _ = self._robust(x0, pct, r_ws[ws], A[ws], pct["lo_e"][:, 1], pct["hi_e"][:, 1])
+            return X, H, conv, info
+        b, f = self._bank, self.track.pp_frame
+        X, ok = kern(np.ascontiguousarray(x0), pct["lo_e"][:, 1] + 1e-9, pct["hi_e"][:, 1] - 1e-9,
+                     pct["sig"], pct["r0"], pct["L"], pct["ow"], pct["orr"], pct["Y0"], pct["Z0"],
+                     pct["ca"], pct["sa"], pct["lo"], pct["hi"], np.ascontiguousarray(r_ws[ws]),
+                     np.ascontiguousarray(A[ws]), b._inner, b.breaks, b._stack, f._inner, f.breaks,
+                     f._stack, self._maxstep, int(n_sample), 1e-9)
+        # outputs at the minimum: one evaluation of the Newton kernel (no step taken)
+        X1, H, _, _, gap, S, V = self._kernel(
+            np.ascontiguousarray(X), pct["sig"], pct["r0"], pct["L"], pct["ow"], pct["orr"], pct["Y0"],
+            pct["Z0"], pct["ca"], pct["sa"], pct["lo"], pct["hi"], np.ascontiguousarray(r_ws[ws]),
+            np.ascontiguousarray(A[ws]), b._inner, b.breaks, b._stack, f._inner, f.breaks, f._stack,
+            0.0, 1, self._maxstep, self._wts)
+        return X, H, ok & np.isfinite(gap), dict(gap=gap, S=S, V=V)
 
     def _gsv(self, x, pc, info):
         """Outputs in the compiled kernel's form dict(gap, S, V) (copies)."""

@@ -122,7 +122,7 @@ from .forces import ContactForces
 from .profiles import WheelProfile
 from .track import RailMounting
 
-__all__ = ["WheelRailContact", "WheelRailKind"]
+__all__ = ["WheelRailContact", "WheelRailKind", "contact_history"]
 
 #: finite-difference steps of the Jacobian: poses (m, rad) and velocities (m/s, rad/s)
 FD_POSE, FD_VELOCITY = 1e-7, 1e-6
@@ -317,7 +317,7 @@ class _Set:
         order = np.argsort(prob, kind="stable")
         return x0[order], prob[order] if P else prob
 
-    def accept_pairs(self, r, Ans, s, reseed):
+    def accept_pairs(self, r, Ans, s, reseed, robust=None):
         """The accepted step's search: both tracked points of the candidates that had a contact
         and, when re-seeding, the two best scan seeds of every candidate where the scan found a
         stationary point near (a sign change of the fourth condition); returns (res, X, G,
@@ -330,7 +330,7 @@ class _Set:
             prob = np.concatenate([prob] + [b for _, b in extra])
             order = np.argsort(prob, kind="stable")
             x0, prob = x0[order], prob[order]
-        res, X, G = self.cs.solve_pairs(x0, prob, r, Ans, s)
+        res, X, G = self.cs.solve_pairs(x0, prob, r, Ans, s, robust=robust)
         return res, X, G, prob
 
     def predicted_seeds(self, s):
@@ -355,6 +355,16 @@ class _Set:
         Ans = self.unspun(A, s)
         x0, prob = self.pairs(s)
         res = self.cs.solve_pairs(x0, prob, r, Ans, s)[0]
+        lost = self.state.valid & ~res.valid.ravel()
+        if np.any(lost):
+            # a tracked contact whose stationary point vanished (the gap's local minimum merged
+            # with a maximum): seeds from the global scan at this pose (a function of q alone)
+            scan = self.cs.scan_seeds(r, Ans, s, ranks=2)
+            extra = [(q[(q[:, 4] > 0.5) & lost, :4], np.flatnonzero((q[:, 4] > 0.5) & lost)) for q in scan]
+            x0 = np.concatenate([x0] + [a for a, _ in extra])
+            prob = np.concatenate([prob] + [b for _, b in extra])
+            order = np.argsort(prob, kind="stable")
+            res = self.cs.solve_pairs(x0[order], prob[order], r, Ans, s, robust=lost)[0]
         if np.any(off):
             gone = np.repeat(off, 2)
             res.valid[gone] = False
@@ -479,9 +489,9 @@ class WheelRailKind(ForceKind):
                     f"the end of the track or far off the rails, at {r[k].round(3).tolist()} m)")
             Ans = st.unspun(A, s)
             reseed = (state.accepted + 1) % st.e.reseed_every == 0
-            res, X, G, prob = st.accept_pairs(r, Ans, s, reseed)
+            res, X, G, prob = st.accept_pairs(r, Ans, s, reseed, robust=state.valid if reseed else None)
             if not reseed and np.any(state.valid & ~res.valid.ravel()):  # a tracked contact was lost
-                res, X, G, prob = st.accept_pairs(r, Ans, s, True)
+                res, X, G, prob = st.accept_pairs(r, Ans, s, True, robust=state.valid)
             f = st.cf(res, r, Ans, v, w)
             out = _wheel_quantities(st, res, f, r, Ans, s, w)
             _check_derailment(st, res, out, state.last_YQ)
@@ -703,3 +713,58 @@ def _check_derailment(st, res, out, last_YQ):
             f"(lateral displacement {y[k] * 1e3:.1f} mm, limit {e.max_lateral_displacement * 1e3:g} mm; "
             f"centre {drop[k] * 1e3:.1f} mm below its nominal height, limit {e.max_drop * 1e3:g} mm); "
             f"wheel {labels[i]!r}: {last(i)}")
+
+
+def contact_history(model, result, element=None, wheels=None):
+    """Per output time and wheel, what a railway engineer reads (long format).
+
+    The outputs of :meth:`WheelRailKind.contact_outputs` are evaluated at the stored states of
+    ``result``, replaying the search state along the output times (reset at the first row, the
+    accept hook after every row), so that the contacts found are those a run with these
+    output times as its steps would have tracked.
+
+    Returns
+    -------
+    DataFrame
+        One row per output time and wheel: ``t [s]``, ``wheel``, ``wheelset``, ``side``, the
+        wheel quantities (``Q [N]``, ``Y [N]``, ``Y/Q [-]``, ``flange contact``, ``flange force
+        [N]``, ``Nadal limit [-]``, ``contact angle [rad]``, ``p_max [Pa]``, ``T gamma [N]``,
+        ``y_wheel [m]``), per-candidate creepages and creep forces of the tread (``_tread``) and
+        flange (``_flange``) candidates, and the wheelset quantities (``s [m]``, ``lateral
+        displacement [m]``, ``angle of attack [rad]``, ``spin [rad/s]``, ``sum Y [N]``, ``speed
+        [m/s]``).
+    """
+    import pandas as pd
+
+    kind = next(k for k in model.force_kinds if isinstance(k, WheelRailKind))
+    st = kind._set(element)
+    saved = st.state
+    rows = []
+    try:
+        for i, t in enumerate(result.t):
+            bs = model.body_states(result.q[i], result.v[i])
+            if i == 0:
+                kind.reset_state(bs, float(t))
+            out = kind.contact_outputs(bs, float(t), st.name)
+            r, A, v, w = st.states(bs)
+            speed = np.einsum("nk,nk->n", v, st.track.evaluate_raw(np.nan_to_num(out["wheelsets"]["s [m]"]))[3][:, :, 0])
+            n = 2 * st.n_ws
+            row = {"t [s]": np.full(n, float(t)),
+                   "wheel": [f"{ws} {sd}" for ws in st.wheelset_names for sd in ("left", "right")],
+                   "wheelset": np.repeat(st.wheelset_names, 2), "side": ["left", "right"] * st.n_ws}
+            row.update({k: np.asarray(v_) for k, v_ in out["wheels"].items()})
+            for k in ("N [N]", "Fx [N]", "Fy [N]", "xi [-]", "eta [-]", "phi [1/m]"):
+                for c, lab in enumerate(("tread", "flange")):
+                    row[f"{k.split(' ')[0]}_{lab} {k.split(' ')[1]}"] = out["contacts"][k][:, c]
+            for k, v_ in out["wheelsets"].items():
+                row[k] = np.repeat(np.asarray(v_), 2)
+            row["speed [m/s]"] = np.repeat(speed, 2)
+            rows.append(pd.DataFrame(row))
+            if i + 1 < len(result.t):
+                kind.accept_step(bs, float(t))
+    finally:
+        st.state = saved
+    df = pd.concat(rows, ignore_index=True)
+    if wheels is not None:
+        df = df[df["wheel"].isin(wheels)].reset_index(drop=True)
+    return df

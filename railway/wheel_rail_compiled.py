@@ -49,7 +49,7 @@ from core.compiled.protocol import (
     force_kernel,
 )
 
-from ._kernels import newton, ppeval, scan
+from ._kernels import newton, ppeval, reduced_min, scan
 from .forces import kernel as contact_forces
 
 __all__ = ["compile_wheel_rail", "describe_failure"]
@@ -322,6 +322,78 @@ def _state_views(state, e, n_ws):
     return seeds, s_ws, val, yq
 
 
+@_jit
+def _robust_merge(fd, ix, e, rws, Ans, xb, valid, gap, S, V, mask):
+    """Problems in ``mask`` without a valid contact: the robust minimisation of the profile-line
+    gap over the whole zone (railway._kernels.reduced_min, 96 samples), merged into the results
+    (ContactSearch._robust_zone)."""
+    n_ws = ix[e, IX_NWS]
+    P = 4 * n_ws
+    K = 0
+    for p in range(P):
+        if mask[p] and not valid[p]:
+            K += 1
+    if K == 0:
+        return
+    idx = np.empty(K, dtype=np.int64)
+    i = 0
+    for p in range(P):
+        if mask[p] and not valid[p]:
+            idx[i] = p
+            i += 1
+    sig, r0, L = _seg1(fd, ix, e, K_SIG), _seg1(fd, ix, e, K_R0), _seg1(fd, ix, e, K_L)
+    ow, orr = _seg1(fd, ix, e, K_OW), _seg1(fd, ix, e, K_ORR)
+    Y0, Z0 = _seg1(fd, ix, e, K_Y0), _seg1(fd, ix, e, K_Z0)
+    ca, sa = _seg1(fd, ix, e, K_CA), _seg1(fd, ix, e, K_SA)
+    lo, hi = _seg2(fd, ix, e, K_LO), _seg2(fd, ix, e, K_HI)
+    lo_e, hi_e = _seg2(fd, ix, e, K_LO_E), _seg2(fd, ix, e, K_HI_E)
+    sc = _seg1(fd, ix, e, K_SCAL)
+    x0 = np.empty((K, 4))
+    msig, mr0, mL, mow, morr = np.empty(K), np.empty(K), np.empty(K), np.empty(K), np.empty(K)
+    mY0, mZ0, mca, msa, ylo, yhi = np.empty(K), np.empty(K), np.empty(K), np.empty(K), np.empty(K), np.empty(K)
+    mlo, mhi = np.empty((K, 4)), np.empty((K, 4))
+    mr = np.empty((K, 3))
+    mA = np.empty((K, 3, 3))
+    for i in range(K):
+        p = idx[i]
+        for c in range(4):
+            x0[i, c] = xb[p, c]
+            mlo[i, c] = lo[p, c]
+            mhi[i, c] = hi[p, c]
+        msig[i], mr0[i], mL[i], mow[i], morr[i] = sig[p], r0[p], L[p], ow[p], orr[p]
+        mY0[i], mZ0[i], mca[i], msa[i] = Y0[p], Z0[p], ca[p], sa[p]
+        ylo[i], yhi[i] = lo_e[p, 1] + 1e-9, hi_e[p, 1] - 1e-9
+        k = p // 4
+        for c in range(3):
+            mr[i, c] = rws[k, c]
+            for d in range(3):
+                mA[i, c, d] = Ans[k, c, d]
+    bi, bb, bs = _seg1(fd, ix, e, K_B_INNER), _seg1(fd, ix, e, K_B_BREAKS), _seg3(fd, ix, e, K_B_STACK)
+    fi, fb, fs = _seg1(fd, ix, e, K_F_INNER), _seg1(fd, ix, e, K_F_BREAKS), _seg3(fd, ix, e, K_F_STACK)
+    ms = _seg1(fd, ix, e, K_MAXSTEP)
+    X, ok = reduced_min(x0, ylo, yhi, msig, mr0, mL, mow, morr, mY0, mZ0, mca, msa, mlo, mhi, mr, mA,
+                        bi, bb, bs, fi, fb, fs, ms, 96, 1e-9)
+    X1, H, cv, it, GAP, S1, V1 = newton(X, msig, mr0, mL, mow, morr, mY0, mZ0, mca, msa, mlo, mhi, mr, mA,
+                                        bi, bb, bs, fi, fb, fs, 0.0, 1, ms, _seg1(fd, ix, e, K_WTS))
+    for i in range(K):
+        p = idx[i]
+        good = ok[i] and np.isfinite(GAP[i]) and GAP[i] > -sc[SC_MAXPEN]
+        for c in range(4):
+            if not (X1[i, c] > lo_e[p, c] and X1[i, c] < hi_e[p, c]):
+                good = False
+        if not good:
+            continue
+        valid[p] = True
+        gap[p] = GAP[i]
+        for c in range(4):
+            xb[p, c] = X1[i, c]
+        for c in range(11):
+            S[p, c] = S1[i, c]
+        for c in range(3):
+            for d in range(3):
+                V[p, c, d] = V1[i, c, d]
+
+
 @force_kernel
 def wheel_rail_forces(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
     """Generalized forces of all wheels (module docstring)."""
@@ -361,6 +433,43 @@ def wheel_rail_forces(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
                     prob[i] = p
                     i += 1
         xb, valid, gap, S, V, _, _ = _solve(fd, ix, e, rws, Ans, x0, prob)
+        n_lost = 0
+        for p in range(P):
+            if val_prev[p] > 0.5 and not valid[p]:
+                n_lost += 1
+        if n_lost > 0:
+            # a tracked stationary point vanished: add the scan's flagged seeds of those
+            # candidates (at this pose: a function of q), problem-major, tracked pairs first
+            sd = _scan_seeds(fd, ix, e, rws, Ans, s, o)
+            K2 = K
+            for p in range(P):
+                if val_prev[p] > 0.5 and not valid[p]:
+                    for j in range(2):
+                        if sd[j, p, 4] > 0.5:
+                            K2 += 1
+            x1 = np.empty((K2, 4))
+            prob1 = np.empty(K2, dtype=np.int64)
+            i = 0
+            i_old = 0
+            for p in range(P):
+                while i_old < K and prob[i_old] == p:
+                    for c in range(4):
+                        x1[i, c] = x0[i_old, c]
+                    prob1[i] = p
+                    i += 1
+                    i_old += 1
+                if val_prev[p] > 0.5 and not valid[p]:
+                    for j in range(2):
+                        if sd[j, p, 4] > 0.5:
+                            for c in range(4):
+                                x1[i, c] = sd[j, p, c]
+                            prob1[i] = p
+                            i += 1
+            xb, valid, gap, S, V, _, _ = _solve(fd, ix, e, rws, Ans, x1, prob1)
+            lostm = np.zeros(P, dtype=np.bool_)
+            for p in range(P):
+                lostm[p] = val_prev[p] > 0.5 and not valid[p]
+            _robust_merge(fd, ix, e, rws, Ans, xb, valid, gap, S, V, lostm)
         for p in range(P):
             if not np.isfinite(s[p // 4]):  # not over the track: no contact
                 valid[p] = False
@@ -506,6 +615,11 @@ def wheel_rail_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
         while True:
             x0, prob = _accept_pairs(fd, ix, e, seeds, s, s_prev, val_prev, rws, Ans, reseed, o)
             xb, valid, gap, S, V, X, Gm = _solve(fd, ix, e, rws, Ans, x0, prob)
+            if reseed:
+                prevm = np.zeros(P, dtype=np.bool_)
+                for p in range(P):
+                    prevm[p] = val_prev[p] > 0.5
+                _robust_merge(fd, ix, e, rws, Ans, xb, valid, gap, S, V, prevm)
             lost_any = False
             for p in range(P):
                 if val_prev[p] > 0.5 and not valid[p]:

@@ -1006,7 +1006,7 @@ class ContactSearch:
         return self._multistart(x0, pc, r_ws[ws], A[ws], False, 0, max_iter=max_iter,
                                 scan_out=scan_out, return_all=True)
 
-    def solve_pairs(self, x0, problem, r_ws, A, s_ws, robust=None, n_sample=96):
+    def solve_pairs(self, x0, problem, r_ws, A, s_ws, robust=None, n_sample=96, secondary=None):
         """Contacts from explicit (seed, problem) pairs, without any state.
 
         Newton runs from every seed ``x0[k]`` (K, 4) for the problem ``problem[k]`` (an index
@@ -1021,6 +1021,11 @@ class ContactSearch:
         (:func:`railway._kernels.reduced_min`, ``n_sample`` samples then golden-section search):
         a contact at the joint of two profile sections or a nearly conformal one, where Newton
         on the four conditions does not converge.
+
+        ``secondary`` (m): also return, in ``res.extra["secondary"]``, a second contact patch
+        per candidate: the lowest penetrating pair solution at least ``secondary`` away on the
+        wheel profile from the primary one (two penetrating minima of the gap carry load
+        together, so that the force stays continuous where the lowest minimum changes).
 
         Returns
         -------
@@ -1067,7 +1072,33 @@ class ContactSearch:
                 for key in info:
                     info[key][todo] = infr[key]
         res = self._finish(x, H0, conv, pc, info, it)
+        if secondary is not None:
+            res.extra["secondary"] = self._secondary(res, problem, xk, Hk, ck, gk, gsv, secondary)
         return res, xk, gk
+
+    def _secondary(self, res, problem, xk, Hk, ck, gk, gsv, separation):
+        """A second contact patch per candidate: the lowest *penetrating* pair solution whose wheel
+        profile coordinate differs from the primary contact's by more than ``separation`` (m);
+        a ContactResult like ``res`` (invalid where there is none)."""
+        pc = self._problems
+        P = pc["ws"].size
+        y1 = res.y_wheel.ravel()
+        x2 = np.full((P, 4), np.nan)
+        H2 = np.full((P, 4), np.inf)
+        c2 = np.zeros(P, dtype=bool)
+        info2 = dict(gap=np.full(P, np.inf), S=np.full((P, 11), np.nan), V=np.full((P, 3, 3), np.nan))
+        if problem.size:
+            far = res.valid.ravel()[problem] & (np.abs(xk[:, 1] - y1[problem]) > separation)
+            g = np.where(far & (gk < 0.0), gk, np.inf)
+            order = np.lexsort((np.arange(problem.size), g, problem))
+            first = order[np.r_[True, problem[order][1:] != problem[order][:-1]]]
+            first = first[np.isfinite(g[first])]
+            p = problem[first]
+            x2[p], H2[p], c2[p] = xk[first], Hk[first], ck[first]
+            for key in info2:
+                info2[key][p] = gsv[key][first]
+        x2 = np.where(np.isnan(x2), pc["lo"].clip(-1.0, 1.0), x2)
+        return self._finish(x2, H2, c2, pc, info2, 0)
 
     def _robust_zone(self, todo, x, r_ws, A, n_sample):
         """Robust minimisation of the profile-line gap over the whole zone of problems ``todo``

@@ -634,6 +634,8 @@ def railway_scenes():
     """The railway scenes (entry point ``mbsuite.scenes: railway``)."""
     from core.scenes import Scene
 
+    from .vehicle_scenes import vehicle_scenes
+
     return [
         Scene("railway-contact-geometry",
               "Wheel-rail contact geometry: S1002 / UIC60 1:40, delta r, contact angles, conicity",
@@ -655,4 +657,4 @@ def railway_scenes():
               "2.4 mrad/mm (Shackleton & Iwnicki 2008, VSD 46:91-120, as in CONTACT's example): "
               "quasi-static rolling with FASTSIM, Polach 2000 and Kalker linear vs CONTACT rev. 2447.",
               _wrap(_run_manchester)),
-    ]
+    ] + vehicle_scenes()

@@ -75,6 +75,34 @@ found because both are iterated at every evaluation.  At each accepted step the 
 are refreshed by a global scan of the cross-section (every ``reseed_every`` accepted steps,
 default 1, and whenever a tracked contact is lost), which is what finds a new minimum.
 
+Two patches per zone
+--------------------
+Each candidate zone (tread, flange) may hold two penetrating local minima of the gap at once,
+e.g. where the S1002 tread and flange root both touch the rail near a contact jump.  Picking only
+the lowest makes the force jump when the two minima exchange places; instead the lowest
+penetrating solution of the other tracked point, at least ``SEPARATION`` (3 mm) away on the wheel
+profile, is a second contact patch with its own Hertz ellipse and creep forces.  Two separate
+patches both carry load; two ellipses that overlap (distance d between the points below the sum
+of their lateral semi-axes b1 + b2: the nearly conformal S1002 tread on the UIC60 crown, one wide
+patch) share one patch's load, handed from the shallower to the deeper one as their gaps g1, g2
+differ:
+
+.. math::
+
+    w = \operatorname{clip}\left(\frac{d - (b_1 + b_2)}{(b_1 + b_2)/2},\ 0,\ 1\right),\quad
+    \sigma = \tfrac12\left(1 + \tanh\frac{g_2 - g_1}{\varepsilon}\right),\quad
+    s_1 = w + (1 - w)\,\sigma,\quad s_2 = w + (1 - w)(1 - \sigma),
+
+with ε = ``BLEND_GAP`` = 10 µm; each patch's normal and creep forces are multiplied by its share.
+The shares are symmetric in the two patches, so the force is continuous where the deeper minimum
+changes (where the single-point model jumps), where a second patch appears (its force starts from
+zero) and where two patches separate.  Without it the error-controlled integrators reject a
+large share of their steps in curves (the force jumps when the S1002 contact point jumps), and
+the results depend on where the steps fall.  The shares are a modelling choice of this code
+between the deepest-point and the two-patch models, not a result of contact theory (CONTACT,
+for comparison, combines patches closer than a distance and separates the others).  Wheel totals
+(Q, Y, Tγ) include both patches; the per-candidate outputs are the primary patch's.
+
 Jacobians
 ---------
 ∂Q/∂q (along velocity-space increments: δr global, δθ in body axes, at fixed body-frame ω̄) and
@@ -87,6 +115,24 @@ geometry does not depend on v).  Steps: 1e-7 m and rad for poses, 1e-6 m/s and r
 velocities.  ``tests/railway/test_wheel_rail.py`` measures them against the analytic
 linearisation of a wheelset on its rails (vertical Hertz stiffness 3/2 N/δ, lateral creep
 damping 2 f22/V, yaw creep damping 2 f11 l²/V).
+
+Nominal spin: a non-rotating wheelset frame for linear analyses
+---------------------------------------------------------------
+A spinning wheelset's body frame turns at V / r0, so a linearisation about a running state in
+body-frame coordinates is the snapshot of a periodic system, not a time-invariant one, and its
+eigenvalues are not those of the hunting motion.  With ``nominal_spin = (Omega, I_y)`` the spin
+is split: the wheelset bodies carry only the perturbation of their rotation (they start without
+spin), the creepages use the angular velocity ω + Omega a, and the nominal spin's angular
+momentum I_y Omega a enters as the gyroscopic moment
+
+.. math::
+
+    M_g = -\frac{d}{dt}(I_y \Omega a) = -I_y \Omega\, (\omega \times a)
+
+(Euler's equations with a constant spin about the moving axle; the formulation of the linear
+wheelset models, Wickens 2003, ch. 2).  The state is then time-invariant in steady running and
+core's :func:`~core.analysis.linearize` / :func:`~core.analysis.eigen` apply (scene
+``railway-critical-speed``).  Integrated runs use the absolute spin.
 
 Loss of contact and derailment
 ------------------------------
@@ -126,6 +172,11 @@ __all__ = ["WheelRailContact", "WheelRailKind", "contact_history"]
 
 #: finite-difference steps of the Jacobian: poses (m, rad) and velocities (m/s, rad/s)
 FD_POSE, FD_VELOCITY = 1e-7, 1e-6
+#: two penetrating minima of the gap in one zone at least this far apart on the wheel profile (m)
+#: are two contact patches that share the load (module docstring, "Two patches per zone")
+SEPARATION = 3e-3
+#: gap difference (m) over which two overlapping patches hand the load over (module docstring)
+BLEND_GAP = 1e-5
 
 
 @dataclass(frozen=True, eq=False)
@@ -157,6 +208,12 @@ class WheelRailContact(ForceElement):
         Lankarani–Nikravesh damping (see :func:`railway.forces.lankarani_nikravesh_force`).
     rail_body : str, optional
         Body carrying the rails (default: the ground).
+    nominal_spin : (float, float), optional
+        ``(Omega, I_spin)``: the non-rotating wheelset formulation for linear analyses (module
+        docstring, "Nominal spin"): the wheelsets' spin is split into a constant nominal rate
+        Omega [rad/s] about the axle, not integrated (the body frames do not turn with it), and
+        the bodies' own rotation; I_spin [kg m²] is the wheelsets' inertia about the axle.  Numpy
+        path only.
     reseed_every : int
         Global re-seeding of the tracked contacts every this many accepted steps (default 1).
     flange_tip_margin, max_lateral_displacement, max_drop : float
@@ -179,6 +236,7 @@ class WheelRailContact(ForceElement):
     restitution: float = 0.9
     approach_velocity_floor: float = 0.1
     rail_body: Any = None
+    nominal_spin: Any = None
     reseed_every: int = 1
     flange_tip_margin: float = 1e-3
     max_lateral_displacement: float = 0.05
@@ -232,6 +290,17 @@ class _Set:
             if not (np.isfinite(v) and v > 0):
                 raise ModelError(f"wheel-rail contact {e.name!r}: {key} = {v!r} m must be positive")
         self.e = e
+        self.spin = None
+        if e.nominal_spin is not None:
+            try:
+                Om, Iy = (float(x) for x in e.nominal_spin)
+            except (TypeError, ValueError):
+                raise ModelError(f"wheel-rail contact {e.name!r}: nominal_spin must be (Omega [rad/s], "
+                                 f"I_spin [kg m^2]), got {e.nominal_spin!r}") from None
+            if not (np.isfinite(Om) and np.isfinite(Iy) and Iy > 0):
+                raise ModelError(f"wheel-rail contact {e.name!r}: nominal_spin = {e.nominal_spin!r} needs a finite "
+                                 "rate and a positive spin inertia")
+            self.spin = (Om, Iy)
         self.cs = ContactSearch(e.track, wheel=wheel, rails=rails, n_wheelsets=len(names),
                                 flange_back_spacing=e.flange_back_spacing, n_seeds=2, tol=1e-11,
                                 tol_linear=1e-11)
@@ -258,10 +327,13 @@ class _Set:
 
     # ---------------------------------------------------------------------------------------
     def states(self, bs):
-        """Wheelset centre, rotation, velocity and global angular velocity, in the rail frame."""
+        """Wheelset centre, rotation, velocity and global angular velocity (with the nominal
+        spin, if any), in the rail frame."""
         r, A = bs.r[self.bw], bs.A[self.bw]
         v = bs.rdot[self.bw]
         w = np.einsum("nij,nj->ni", A, bs.w[self.bw])  # global angular velocity
+        if self.spin is not None:
+            w = w + self.spin[0] * A[:, :, 1]
         if self.rb is None:
             return r, A, v, w
         rR, AR = bs.r[self.rb], bs.A[self.rb]
@@ -326,11 +398,15 @@ class _Set:
         if reseed:
             scan = self.cs.scan_seeds(r, Ans, s, ranks=2)
             extra = [(q[q[:, 4] > 0.5, :4], np.flatnonzero(q[:, 4] > 0.5)) for q in scan]
+            # a candidate where the scan found a stationary point is refined robustly as well
+            # when Newton fails there (e.g. a flange touching the rail after a lift-off)
+            flagged = np.any([q[:, 4] > 0.5 for q in scan], axis=0)
+            robust = flagged if robust is None else (np.asarray(robust, bool) | flagged)
             x0 = np.concatenate([x0] + [a for a, _ in extra])
             prob = np.concatenate([prob] + [b for _, b in extra])
             order = np.argsort(prob, kind="stable")
             x0, prob = x0[order], prob[order]
-        res, X, G = self.cs.solve_pairs(x0, prob, r, Ans, s, robust=robust)
+        res, X, G = self.cs.solve_pairs(x0, prob, r, Ans, s, robust=robust, secondary=SEPARATION)
         return res, X, G, prob
 
     def predicted_seeds(self, s):
@@ -354,7 +430,7 @@ class _Set:
             s = np.where(off, self.state.s_ws, s)
         Ans = self.unspun(A, s)
         x0, prob = self.pairs(s)
-        res = self.cs.solve_pairs(x0, prob, r, Ans, s)[0]
+        res = self.cs.solve_pairs(x0, prob, r, Ans, s, secondary=SEPARATION)[0]
         lost = self.state.valid & ~res.valid.ravel()
         if np.any(lost):
             # a tracked contact whose stationary point vanished (the gap's local minimum merged
@@ -364,23 +440,50 @@ class _Set:
             x0 = np.concatenate([x0] + [a for a, _ in extra])
             prob = np.concatenate([prob] + [b for _, b in extra])
             order = np.argsort(prob, kind="stable")
-            res = self.cs.solve_pairs(x0[order], prob[order], r, Ans, s, robust=lost)[0]
+            res = self.cs.solve_pairs(x0[order], prob[order], r, Ans, s, robust=lost,
+                                      secondary=SEPARATION)[0]
+        res2 = res.extra["secondary"]
         if np.any(off):
             gone = np.repeat(off, 2)
-            res.valid[gone] = False
-            res.in_contact[gone] = False
-            res.gap[gone] = np.inf
-            res.penetration[gone] = -np.inf
-        f = self.cf(res, r, Ans, v, w)
+            for rr in (res, res2):
+                rr.valid[gone] = False
+                rr.in_contact[gone] = False
+                rr.gap[gone] = np.inf
+                rr.penetration[gone] = -np.inf
+        f = self.forces(res, r, Ans, v, w)
         return res, f, np.where(off, np.nan, s), Ans
 
+    def forces(self, res, r, Ans, v, w):
+        """Forces of the primary contacts and of the second patches (``f["secondary"]``), the
+        latter weighted by their separation from the primary (module docstring)."""
+        f = self.cf(res, r, Ans, v, w)
+        res2 = res.extra.get("secondary")
+        if res2 is None:
+            zero = {k: np.zeros_like(v_) for k, v_ in f.items()}
+            f["secondary"] = zero
+            return f
+        f2 = self.cf(res2, r, Ans, v, w)
+        s1, s2 = patch_shares(res.y_wheel, res2.y_wheel, res.gap, res2.gap, f["b"], f2["b"], f2["N"] > 0)
+        for ff, sh in ((f, s1), (f2, s2)):
+            for k in ("N", "Fx", "Fy", "Mz"):
+                ff[k] = ff[k] * sh
+            ff["force"] = ff["force"] * sh[..., None]
+            ff["moment"] = ff["moment"] * sh[..., None]
+        f["secondary"] = f2
+        return f
+
     def generalized(self, r, A_body, res, f):
-        """Q of the wheelsets (n_ws, 6) in rail-frame components (rotation part in body axes)."""
-        valid = res.valid[..., None]
-        p = np.where(valid, res.point_wheel, 0.0).reshape(self.n_ws, 4, 3)
-        F = f["force"].reshape(self.n_ws, 4, 3)
-        M = f["moment"].reshape(self.n_ws, 4, 3)
-        arm = np.where(valid.reshape(self.n_ws, 4, 1), p - r[:, None, :], 0.0)
+        """Force and moment sums of every wheelset's contacts (primary and secondary patches),
+        rail-frame components: Ft, Mt (n_ws, 3) and the contacts' points, forces, moments
+        (n_ws, 8, 3)."""
+        ps, Fs, Ms = [], [], []
+        for rr, ff in ((res, f), (res.extra["secondary"], f["secondary"])):
+            valid = rr.valid[..., None]
+            ps.append(np.where(valid, rr.point_wheel, 0.0).reshape(self.n_ws, 4, 3))
+            Fs.append(ff["force"].reshape(self.n_ws, 4, 3))
+            Ms.append(ff["moment"].reshape(self.n_ws, 4, 3))
+        p, F, M = (np.concatenate(a, axis=1) for a in (ps, Fs, Ms))
+        arm = np.where(np.any(p != 0.0, axis=2, keepdims=True), p - r[:, None, :], 0.0)
         Ft = F.sum(axis=1)
         Mt = (np.cross(arm, F) + M).sum(axis=1)
         return Ft, Mt, p, F, M
@@ -390,6 +493,11 @@ class _Set:
         r, A, v, w = self.states(bs)
         res, f, _, _ = self.contacts(r, A, v, w, s)
         Ft, Mt, p, F, M = self.generalized(r, A, res, f)
+        if self.spin is not None:  # gyroscopic moment of the nominal spin, -I Omega (omega x a)
+            Om, Iy = self.spin
+            a = A[:, :, 1]
+            w_body = w - Om * a
+            Mt = Mt - Iy * Om * np.cross(w_body, a)
         if self.rb is None:
             Qw = np.concatenate([Ft, np.einsum("nji,nj->ni", A, Mt)], axis=1)
             return self.bw, Qw
@@ -474,7 +582,9 @@ class WheelRailKind(ForceKind):
         for st in self.sets:
             st.state = self._fresh_state(st, bs)
 
-    def accept_step(self, bs, t):
+    def accept_step(self, bs, t, reseed=False):
+        """Search-state update after an accepted step (module docstring); ``reseed=True`` scans
+        whatever ``reseed_every`` says (the replay of :func:`contact_history`)."""
         for st in self.sets:
             state = st.state
             if state is None:
@@ -488,11 +598,11 @@ class WheelRailKind(ForceKind):
                     f"wheelset {st.wheelset_names[k]!r} ({st.name}) is no longer over the track (beyond "
                     f"the end of the track or far off the rails, at {r[k].round(3).tolist()} m)")
             Ans = st.unspun(A, s)
-            reseed = (state.accepted + 1) % st.e.reseed_every == 0
+            reseed = reseed or (state.accepted + 1) % st.e.reseed_every == 0
             res, X, G, prob = st.accept_pairs(r, Ans, s, reseed, robust=state.valid if reseed else None)
             if not reseed and np.any(state.valid & ~res.valid.ravel()):  # a tracked contact was lost
                 res, X, G, prob = st.accept_pairs(r, Ans, s, True, robust=state.valid)
-            f = st.cf(res, r, Ans, v, w)
+            f = st.forces(res, r, Ans, v, w)
             out = _wheel_quantities(st, res, f, r, Ans, s, w)
             _check_derailment(st, res, out, state.last_YQ)
             xb = np.column_stack([res.theta.ravel(), res.y_wheel.ravel(), res.s_rail.ravel(), res.u_rail.ravel()])
@@ -544,6 +654,21 @@ class WheelRailKind(ForceKind):
 
 
 # ------------------------------------------------------------------------------------------
+def patch_shares(y1, y2, g1, g2, b1, b2, second):
+    """Shares (s1, s2) of the primary and second patches' forces (module docstring)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        d = np.abs(y2 - y1)
+        bsum = b1 + b2
+        w = np.clip((d - bsum) / (0.5 * np.where(bsum > 0, bsum, 1.0)), 0.0, 1.0)
+        sig = 0.5 * (1.0 + np.tanh((g2 - g1) / BLEND_GAP))
+    ok = second & np.isfinite(d) & np.isfinite(g2)
+    w = np.where(ok, w, 0.0)
+    sig = np.where(ok, sig, 1.0)
+    s1 = np.where(ok, w + (1.0 - w) * sig, 1.0)
+    s2 = np.where(ok, w + (1.0 - w) * (1.0 - sig), 0.0)
+    return s1, s2
+
+
 def _two_lowest_pairs(xb, valid, X, G, prob, old, distinct=1e-4):
     """Tracked points (2, P, 4) after an accepted step: per candidate the solution ``xb`` and the
     lowest other pair solution at least ``distinct`` (m) away in the wheel profile coordinate
@@ -610,23 +735,14 @@ def _wheel_quantities(st, res, f, r, Ans, s, w):
     wheelset's ΣY is the lateral force of the axle on the track in the track's lateral axis
     (positive to the left).
     """
-    try:
-        from .assessment import max_pressure, nadal_limit, wear_number
-    except ImportError:  # TEMPORARY until railway.assessment lands
-        def max_pressure(N, a, b):
-            return 1.5 * N / (np.pi * a * b)
-
-        def nadal_limit(g, mu):
-            return (np.tan(g) - mu) / (1 + mu * np.tan(g))
-
-        def wear_number(Fx, Fy, xi, eta):
-            return np.abs(Fx * xi) + np.abs(Fy * eta)
+    from .assessment import max_pressure, nadal_limit, wear_number
 
     n_ws = st.n_ws
     fr = st.track.evaluate_raw(s)
     pos, R = fr[0], fr[3]
     t_tr, lat, up = R[:, :, 0], R[:, :, 1], R[:, :, 2]
-    Fw = f["force"].reshape(n_ws, 2, 2, 3)  # on the wheel
+    f2 = f["secondary"]
+    Fw = (f["force"] + f2["force"]).reshape(n_ws, 2, 2, 3)  # on the wheel, both patches
     side = np.array([1.0, -1.0])
     Fsum = Fw.sum(axis=2)  # per wheel
     Q = np.einsum("nsk,nk->ns", Fsum, up)
@@ -635,16 +751,22 @@ def _wheel_quantities(st, res, f, r, Ans, s, w):
     with np.errstate(divide="ignore", invalid="ignore"):
         YQ = np.where(Q > 0, Y / Q, np.nan)
     N = f["N"].reshape(n_ws, 2, 2)
+    N2 = f2["N"].reshape(n_ws, 2, 2)
+    res2 = res.extra["secondary"]
     loaded = N > 0
     gam = np.where(res.valid, res.contact_angle, np.nan).reshape(n_ws, 2, 2)
+    gam2 = np.where(res2.valid & (N2.reshape(-1, 2) > 0), res2.contact_angle, -np.inf).reshape(n_ws, 2, 2)
     # the flange contact of a wheel: the loaded candidate with the larger contact angle
-    gmax = np.where(loaded, gam, -np.inf).max(axis=2)
-    flange = loaded.any(axis=2) & (gmax > np.radians(45.0))
+    gmax = np.maximum(np.where(loaded, gam, -np.inf).max(axis=2), gam2.max(axis=2))
+    flange = (loaded.any(axis=2) | (N2 > 0).any(axis=2)) & (gmax > np.radians(45.0))
     lim = np.where(flange, nadal_limit(np.where(np.isfinite(gmax), gmax, 0.0), st.e.mu), np.nan)
     a, b = f["a"].reshape(n_ws, 2, 2), f["b"].reshape(n_ws, 2, 2)
+    a2, b2 = f2["a"].reshape(n_ws, 2, 2), f2["b"].reshape(n_ws, 2, 2)
     with np.errstate(divide="ignore", invalid="ignore"):
         pmax = np.where(loaded, max_pressure(N, a, b), 0.0)
-    Tg = wear_number(f["Fx"], f["Fy"], f["xi"], f["eta"]).reshape(n_ws, 2, 2)
+        pmax2 = np.where(N2 > 0, max_pressure(N2, a2, b2), 0.0)
+    Tg = (wear_number(f["Fx"], f["Fy"], f["xi"], f["eta"])
+          + wear_number(f2["Fx"], f2["Fy"], f2["xi"], f2["eta"])).reshape(n_ws, 2, 2)
     d = r - pos
     y_ws = np.einsum("nk,nk->n", d, lat)
     z_ws = np.einsum("nk,nk->n", d, up)
@@ -653,9 +775,11 @@ def _wheel_quantities(st, res, f, r, Ans, s, w):
     spin = np.einsum("nk,nk->n", w, Ans[:, :, 1])
     out = {
         "Q [N]": Q.ravel(), "Y [N]": Y.ravel(), "Y/Q [-]": YQ.ravel(),
-        "flange contact": flange.ravel(), "flange force [N]": np.where(flange, N.max(axis=2), 0.0).ravel(),
+        "flange contact": flange.ravel(),
+        "flange force [N]": np.where(flange, np.maximum(N.max(axis=2), N2.max(axis=2)), 0.0).ravel(),
+        "second patch N [N]": N2.sum(axis=2).ravel(),
         "Nadal limit [-]": lim.ravel(), "contact angle [rad]": np.where(np.isfinite(gmax), gmax, np.nan).ravel(),
-        "p_max [Pa]": pmax.max(axis=2).ravel(), "T gamma [N]": Tg.sum(axis=2).ravel(),
+        "p_max [Pa]": np.maximum(pmax, pmax2).max(axis=2).ravel(), "T gamma [N]": Tg.sum(axis=2).ravel(),
         "y_wheel [m]": res.y_wheel.reshape(n_ws, 2, 2)[..., 0].ravel(),
         "flange tip distance [m]": _tip_distance(st, res).ravel(),
     }
@@ -761,7 +885,7 @@ def contact_history(model, result, element=None, wheels=None):
             row["speed [m/s]"] = np.repeat(speed, 2)
             rows.append(pd.DataFrame(row))
             if i + 1 < len(result.t):
-                kind.accept_step(bs, float(t))
+                kind.accept_step(bs, float(t), reseed=True)
     finally:
         st.state = saved
     df = pd.concat(rows, ignore_index=True)

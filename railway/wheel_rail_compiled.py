@@ -51,6 +51,7 @@ from core.compiled.protocol import (
 
 from ._kernels import newton, ppeval, reduced_min, scan
 from .forces import kernel as contact_forces
+from .wheel_rail import BLEND_GAP, SEPARATION
 
 __all__ = ["compile_wheel_rail", "describe_failure"]
 
@@ -229,7 +230,7 @@ def _solve(fd, ix, e, rws, Ans, x0, prob):
     Sb = np.full((P, 11), np.nan)
     Vb = np.full((P, 3, 3), np.nan)
     if K == 0:
-        return xb, valid, gap, Sb, Vb, x0.copy(), Ga
+        return xb, valid, gap, Sb, Vb, x0.copy(), Ga, np.zeros((0, 11)), np.zeros((0, 3, 3))
     X, H0, conv, it, GAP, S, V = newton(
         x0, msig, mr0, mL, mow, morr, mY0, mZ0, mca, msa, mlo, mhi, mr, mA,
         _seg1(fd, ix, e, K_B_INNER), _seg1(fd, ix, e, K_B_BREAKS), _seg3(fd, ix, e, K_B_STACK),
@@ -259,12 +260,98 @@ def _solve(fd, ix, e, rws, Ans, x0, prob):
             for c in range(3):
                 for d in range(3):
                     Vb[p, c, d] = V[i, c, d]
-    # zone-overlap duplicates: keep the candidate whose own zone holds the point
+    _dedup(xb, valid, gap, Sb, Vb, sc[SC_YSPLIT])
+    return xb, valid, gap, Sb, Vb, X, Ga, S, V
+
+
+@_jit
+def _second(xb, valid, X, Ga, Sp, Vp, prob, sep):
+    """Second contact patch per candidate (railway.wheel_rail, "Two patches per zone"): the
+    lowest penetrating pair solution at least ``sep`` away from the primary on the wheel
+    profile.  Returns valid2 (P), gap2 (P), S2 (P, 11), V2 (P, 3, 3)."""
+    P = valid.shape[0]
+    valid2 = np.zeros(P, dtype=np.bool_)
+    gap2 = np.full(P, np.inf)
+    S2 = np.full((P, 11), np.nan)
+    V2 = np.full((P, 3, 3), np.nan)
+    best = np.full(P, -1, dtype=np.int64)
+    for i in range(prob.shape[0]):
+        p = prob[i]
+        if valid[p] and Ga[i] < 0.0 and abs(X[i, 1] - xb[p, 1]) > sep and Ga[i] < gap2[p]:
+            gap2[p] = Ga[i]
+            best[p] = i
+    for p in range(P):
+        i = best[p]
+        if i < 0:
+            continue
+        valid2[p] = True
+        for c in range(11):
+            S2[p, c] = Sp[i, c]
+        for c in range(3):
+            for d in range(3):
+                V2[p, c, d] = Vp[i, c, d]
+    return valid2, gap2, S2, V2
+
+
+@_jit
+def _weigh_second(Sb, gb, out, Fg, Mg, P):
+    """Shares of the primary and second patches (railway.wheel_rail.patch_shares)."""
+    for p in range(P):
+        q = P + p
+        if not (out[q, 0] > 0.0):
+            continue
+        d = abs(Sb[q, 1] - Sb[p, 1])
+        if not (np.isfinite(d) and np.isfinite(gb[q])):
+            for k in range(4):
+                out[q, k] = 0.0
+            for k in range(3):
+                Fg[q, k] = 0.0
+                Mg[q, k] = 0.0
+            continue
+        bsum = out[p, 8] + out[q, 8]
+        w = (d - bsum) / (0.5 * (bsum if bsum > 0.0 else 1.0))
+        w = min(max(w, 0.0), 1.0)
+        sig = 0.5 * (1.0 + np.tanh((gb[q] - gb[p]) / BLEND_GAP))
+        s1 = w + (1.0 - w) * sig
+        s2 = w + (1.0 - w) * (1.0 - sig)
+        for k in range(4):
+            out[p, k] *= s1
+            out[q, k] *= s2
+        for k in range(3):
+            Fg[p, k] *= s1
+            Mg[p, k] *= s1
+            Fg[q, k] *= s2
+            Mg[q, k] *= s2
+
+
+@_jit
+def _both(valid, gap, S, V, valid2, gap2, S2, V2):
+    """Primary and secondary patches stacked (2P) for the forces kernel."""
+    P = valid.shape[0]
+    vb = np.empty(2 * P, dtype=np.bool_)
+    gb = np.empty(2 * P)
+    Sb = np.empty((2 * P, 11))
+    Vb = np.empty((2 * P, 3, 3))
+    for p in range(P):
+        vb[p], vb[P + p] = valid[p], valid2[p]
+        gb[p], gb[P + p] = gap[p], gap2[p]
+        for c in range(11):
+            Sb[p, c], Sb[P + p, c] = S[p, c], S2[p, c]
+        for c in range(3):
+            for d in range(3):
+                Vb[p, c, d], Vb[P + p, c, d] = V[p, c, d], V2[p, c, d]
+    return vb, gb, Sb, Vb
+
+
+@_jit
+def _dedup(xb, valid, gap, Sb, Vb, y_split):
+    """Zone-overlap duplicates: keep the candidate whose own zone holds the point."""
+    P = valid.shape[0]
     for w_ in range(P // 2):
         pt, pf = 2 * w_, 2 * w_ + 1
         if (valid[pt] and valid[pf] and abs(xb[pt, 1] - xb[pf, 1]) < 1e-5
                 and abs(xb[pt, 3] - xb[pf, 3]) < 1e-5):
-            drop = pt if xb[pt, 1] < sc[SC_YSPLIT] else pf
+            drop = pt if xb[pt, 1] < y_split else pf
             valid[drop] = False
             gap[drop] = np.inf
             for c in range(11):
@@ -272,7 +359,6 @@ def _solve(fd, ix, e, rws, Ans, x0, prob):
             for c in range(3):
                 for d in range(3):
                     Vb[drop, c, d] = np.nan
-    return xb, valid, gap, Sb, Vb, X, Ga
 
 
 @_jit
@@ -292,7 +378,7 @@ def _forces(fd, ix, e, valid, gap, S, V, rws, vws, wws, Ans):
     for p in range(P):
         pen[p] = -gap[p]
         kwr[p], kwl[p], krr[p], krl[p] = S[p, 7], S[p, 8], S[p, 9], S[p, 10]
-        ws_of[p] = p // 4
+        ws_of[p] = (p // 4) % rws.shape[0]
         if valid[p]:
             for i in range(3):
                 Pt[p, i] = V[p, 0, i]
@@ -392,6 +478,7 @@ def _robust_merge(fd, ix, e, rws, Ans, xb, valid, gap, S, V, mask):
         for c in range(3):
             for d in range(3):
                 V[p, c, d] = V1[i, c, d]
+    _dedup(xb, valid, gap, S, V, sc[SC_YSPLIT])
 
 
 @force_kernel
@@ -432,7 +519,8 @@ def wheel_rail_forces(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
                     x0[i, 2] += ds
                     prob[i] = p
                     i += 1
-        xb, valid, gap, S, V, _, _ = _solve(fd, ix, e, rws, Ans, x0, prob)
+        xb, valid, gap, S, V, Xp, Gp, Sp, Vp = _solve(fd, ix, e, rws, Ans, x0, prob)
+        prob_used = prob
         n_lost = 0
         for p in range(P):
             if val_prev[p] > 0.5 and not valid[p]:
@@ -465,27 +553,33 @@ def wheel_rail_forces(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
                                 x1[i, c] = sd[j, p, c]
                             prob1[i] = p
                             i += 1
-            xb, valid, gap, S, V, _, _ = _solve(fd, ix, e, rws, Ans, x1, prob1)
+            xb, valid, gap, S, V, Xp, Gp, Sp, Vp = _solve(fd, ix, e, rws, Ans, x1, prob1)
+            prob_used = prob1
             lostm = np.zeros(P, dtype=np.bool_)
             for p in range(P):
                 lostm[p] = val_prev[p] > 0.5 and not valid[p]
             _robust_merge(fd, ix, e, rws, Ans, xb, valid, gap, S, V, lostm)
+        valid2, gap2, S2, V2 = _second(xb, valid, Xp, Gp, Sp, Vp, prob_used, SEPARATION)
         for p in range(P):
             if not np.isfinite(s[p // 4]):  # not over the track: no contact
                 valid[p] = False
                 gap[p] = np.inf
-        out, Fg, Mg, vmin = _forces(fd, ix, e, valid, gap, S, V, rws, vws, wws, Ans)
+                valid2[p] = False
+                gap2[p] = np.inf
+        vb, gb, Sb, Vb = _both(valid, gap, S, V, valid2, gap2, S2, V2)
+        out, Fg, Mg, vmin = _forces(fd, ix, e, vb, gb, Sb, Vb, rws, vws, wws, Ans)
+        _weigh_second(Sb, gb, out, Fg, Mg, P)
         if ix[e, IX_MODEL] >= 0 and vmin < 1e-3:
             err[1] = e
             return ELEMENT_FAILED
         for k in range(n_ws):
             b = bw[k]
             F0 = F1 = F2 = M0 = M1 = M2 = 0.0
-            for c in range(4):
-                p = 4 * k + c
-                if not valid[p]:
+            for c in range(8):
+                p = 4 * k + c if c < 4 else P + 4 * k + c - 4
+                if not vb[p]:
                     continue
-                ax_, ay_, az_ = V[p, 0, 0] - rws[k, 0], V[p, 0, 1] - rws[k, 1], V[p, 0, 2] - rws[k, 2]
+                ax_, ay_, az_ = Vb[p, 0, 0] - rws[k, 0], Vb[p, 0, 1] - rws[k, 1], Vb[p, 0, 2] - rws[k, 2]
                 fx, fy, fz = Fg[p, 0], Fg[p, 1], Fg[p, 2]
                 F0 += fx
                 F1 += fy
@@ -587,7 +681,10 @@ def _accept_pairs(fd, ix, e, seeds, s, s_prev, val_prev, rws, Ans, reseed, o):
                     x0[i, c] = sd[j, p, c]
                 prob[i] = p
                 i += 1
-    return x0, prob
+    flagged = np.zeros(P, dtype=np.bool_)
+    for p in range(P):
+        flagged[p] = sd[0, p, 4] > 0.5 or sd[1, p, 4] > 0.5
+    return x0, prob, flagged
 
 
 @accept_kernel
@@ -613,12 +710,12 @@ def wheel_rail_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
                 return ELEMENT_FAILED
         reseed = (int(row[ST_ACC]) + 1) % ix[e, IX_RESEED] == 0
         while True:
-            x0, prob = _accept_pairs(fd, ix, e, seeds, s, s_prev, val_prev, rws, Ans, reseed, o)
-            xb, valid, gap, S, V, X, Gm = _solve(fd, ix, e, rws, Ans, x0, prob)
+            x0, prob, flagged = _accept_pairs(fd, ix, e, seeds, s, s_prev, val_prev, rws, Ans, reseed, o)
+            xb, valid, gap, S, V, X, Gm, Sp, Vp = _solve(fd, ix, e, rws, Ans, x0, prob)
             if reseed:
                 prevm = np.zeros(P, dtype=np.bool_)
                 for p in range(P):
-                    prevm[p] = val_prev[p] > 0.5
+                    prevm[p] = val_prev[p] > 0.5 or flagged[p]
                 _robust_merge(fd, ix, e, rws, Ans, xb, valid, gap, S, V, prevm)
             lost_any = False
             for p in range(P):
@@ -627,7 +724,10 @@ def wheel_rail_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
             if not lost_any or reseed:
                 break
             reseed = True
-        out, Fg, Mg, vmin = _forces(fd, ix, e, valid, gap, S, V, rws, vws, wws, Ans)
+        valid2, gap2, S2, V2 = _second(xb, valid, X, Gm, Sp, Vp, prob, SEPARATION)
+        vb, gb, Sb, Vb = _both(valid, gap, S, V, valid2, gap2, S2, V2)
+        out, Fg, Mg, vmin = _forces(fd, ix, e, vb, gb, Sb, Vb, rws, vws, wws, Ans)
+        _weigh_second(Sb, gb, out, Fg, Mg, P)
         # per wheel: Y/Q (module docstring of railway.wheel_rail), flange tip distance; per
         # wheelset: lateral displacement and drop.  The checks in the numpy kind's order:
         # flange climb first, then a wheelset that left the rails.
@@ -641,8 +741,8 @@ def wheel_rail_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
             for side in range(2):
                 wi = 2 * k + side
                 Fz = Fy = 0.0
-                for c in range(2):
-                    p = 4 * k + 2 * side + c
+                for c in range(4):  # tread, flange, and their second patches
+                    p = 4 * k + 2 * side + c if c < 2 else P + 4 * k + 2 * side + c - 2
                     Fz += Fg[p, 0] * o[5] + Fg[p, 1] * o[8] + Fg[p, 2] * o[11]
                     Fy += Fg[p, 0] * o[4] + Fg[p, 1] * o[7] + Fg[p, 2] * o[10]
                 Y = -Fy * (1.0 if side == 0 else -1.0)
@@ -782,6 +882,9 @@ def compile_wheel_rail(kind, layout) -> CompiledForces:
         if st.rb is not None:
             raise NotCompilable(f"wheel-rail contact {st.name!r}: rails on a body (rail_body) run on the numpy "
                                 "path only")
+        if st.spin is not None:
+            raise NotCompilable(f"wheel-rail contact {st.name!r}: the nominal-spin formulation (for linear "
+                                "analyses) runs on the numpy path only")
         if st.cf._model_code is None:
             raise NotCompilable(f"wheel-rail contact {st.name!r}: creep law {st.cf.creep_law!r} has no "
                                 "compiled form (user laws and join='raw' run on the numpy path)")

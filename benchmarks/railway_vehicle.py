@@ -1,0 +1,183 @@
+"""Railway vehicle speed and work-precision (issue 10's benchmarks).
+
+1. Work-precision on 5 s of the curving run (Manchester coach, 200 m curve, 20 m/s, Polach 2000,
+   from the straight into the full curve): error of the leading wheelset's lateral displacement
+   and of the leading outer wheel's lateral force Y, max over 100 Hz outputs, against a tight
+   reference (jit-dop853, rtol 1e-9), for the compiled explicit (jit-rk45, jit-dop853) and
+   implicit (jit-radau) integrators over a tolerance grid; wall time of each run.
+2. Real-time factor (simulated time / wall time) of 30 s of running on the 200 m curve (a 400 m
+   long curve so that 30 s at 10 m/s stay in it) with the recommended integrator, and where the
+   time goes: right-hand sides (contact kernel and the rest) and accepted-step updates.
+3. The flying wheelset and the linear critical-speed sweep, timed.
+
+Run:  .venv/bin/python benchmarks/railway_vehicle.py [--quick]
+Writes benchmarks/results/railway_vehicle.md (and .csv tables).  One process, one core (numba
+is single-threaded here); run it on an otherwise idle machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np
+import pandas as pd
+
+RESULTS = Path(__file__).resolve().parent / "results"
+
+
+def _errors(res, ref, veh):
+    from railway.wheel_rail import contact_history
+
+    ws = veh.wheelsets[0]
+    y = res.coordinates()[f"{ws}.y [m]"].to_numpy()
+    yr = ref.coordinates()[f"{ws}.y [m]"].to_numpy()
+    return float(np.max(np.abs(y - yr)))
+
+
+def work_precision(quick=False):
+    from core.integrators import simulate
+    from railway.vehicle_scenes import run_curving
+
+    V, T = 20.0, 5.0
+    ref, veh = run_curving("polach2000", V, T=T, rtol=1e-9, n_output_per_s=100)
+    assert ref.success, ref.message
+    rows = []
+    grids = {"jit-dop853": [1e-3, 1e-4, 1e-5, 1e-6, 1e-7], "jit-rk45": [1e-3, 1e-4, 1e-5, 1e-6],
+             "jit-radau": [1e-3, 1e-4, 1e-5]}
+    if quick:
+        grids = {k: v[:2] for k, v in grids.items()}
+    q0, v0 = veh.initial_state()
+    for method, tols in grids.items():
+        for rtol in tols:
+            simulate(veh.model, (0.0, 0.01), method, q0=q0, v0=v0, rtol=rtol, atol=rtol * 1e-2)  # compile
+            t0 = time.perf_counter()
+            res = simulate(veh.model, (0.0, T), method, q0=q0, v0=v0, rtol=rtol, atol=rtol * 1e-2,
+                           n_output=int(T * 100) + 1)
+            wall = time.perf_counter() - t0
+            err = _errors(res, ref, veh) if res.success else np.nan
+            rows.append({"method": method, "rtol": rtol, "status": res.status, "wall time [s]": wall,
+                         "error lateral displacement, leading wheelset [m]": err,
+                         "steps": res.counters["n_steps"], "rejected": res.counters["n_rejected"],
+                         "rhs": res.counters["n_rhs"]})
+            print(rows[-1], flush=True)
+    return pd.DataFrame(rows)
+
+
+def real_time(method="jit-dop853", rtol=1e-4, V=10.0, T=30.0):
+    from core.compiled import dynamics as D
+    from core.compiled.layout import compile_model
+    from core.integrators import simulate
+    from railway.vehicle_scenes import curving_track, run_curving
+
+    track = curving_track(curve_length=400.0)
+    run_curving("polach2000", V, T=0.05, track=track, method=method, rtol=rtol)  # compile and cache
+    t0 = time.perf_counter()
+    res, veh = run_curving("polach2000", V, T=T, track=track, method=method, rtol=rtol, n_output_per_s=10)
+    wall_all = time.perf_counter() - t0
+    # the integration alone (the run above also built the model and solved the preload)
+    q0, v0 = veh.initial_state()
+    t0 = time.perf_counter()
+    res = simulate(veh.model, (0.0, T), method, q0=q0, v0=v0, rtol=rtol, atol=rtol * 1e-2, n_output=int(T * 10) + 1)
+    wall = time.perf_counter() - t0
+    # cost of one right-hand side (all kinds) and of the contact kernel alone, at a state in the curve
+    m = veh.model
+    k = len(res.t) // 2
+    q, v = np.array(res.q[k]), np.array(res.v[k])
+    m.begin_run(res.t[k], q, v)
+    cm = compile_model(m)
+    ws = D.make_workspace(cm)
+    st = cm.initial_states()
+    Q = np.zeros(m.n_v)
+    n = 2000
+    t0 = time.perf_counter()
+    for _ in range(n):
+        Q[:] = 0.0
+        D.body_states(cm.fields["lay"], q, v, ws)
+        D.forces(cm.data, st, ws, res.t[k], q, v, Q)
+    rhs = (time.perf_counter() - t0) / n
+    kc = next(i for i, r in enumerate(cm.force_kinds) if r.what == "wheel-rail contact")
+    rec = cm.force_kinds[kc]
+    sk = st[cm._st_off[kc]:cm._st_off[kc + 1]].reshape(cm._st_n[kc], cm._st_w[kc]).copy()
+    err = np.zeros(3, np.int64)
+    f = rec.forces.dispatcher
+    t0 = time.perf_counter()
+    for _ in range(n):
+        f(res.t[k], q, v, ws.r, ws.A, ws.rd, ws.w, cm.fields["lay"], rec.fd, rec.ix, sk, Q, err)
+    contact = (time.perf_counter() - t0) / n
+    acc = rec.accept.dispatcher
+    na = 300
+    t0 = time.perf_counter()
+    for _ in range(na):
+        s2 = sk.copy()
+        acc(res.t[k], q, v, ws.r, ws.A, ws.rd, ws.w, cm.fields["lay"], rec.fd, rec.ix, s2, err)
+    accept = (time.perf_counter() - t0) / na
+    c = res.counters
+    return {"method": method, "rtol": rtol, "speed [m/s]": V, "simulated [s]": T, "status": res.status,
+            "wall time, integration [s]": wall, "real-time factor [-]": T / wall,
+            "wall time incl. build and preload [s]": wall_all, "steps": c["n_steps"], "rejected": c["n_rejected"],
+            "rhs": c["n_rhs"], "rhs, all kinds [us]": rhs * 1e6, "contact kernel [us]": contact * 1e6,
+            "accept update [us]": accept * 1e6,
+            "share: contact in rhs [-]": c["n_rhs"] * contact / wall,
+            "share: other kinds in rhs [-]": c["n_rhs"] * (rhs - contact) / wall,
+            "share: accepted-step updates [-]": c["n_steps"] * accept / wall}
+
+
+def timed_cases():
+    from core.integrators import simulate
+    from railway.two_point import conical_wheel
+    from railway.vehicle_scenes import linear_critical_speed
+    from railway.wheelset_models import free_wheelset
+
+    rows = []
+    m = free_wheelset(5.0, 0.002, wheel=conical_wheel(), track_length=130.0)
+    simulate(m, (0.0, 0.01), "jit-dop853", rtol=1e-7, atol=1e-9)
+    t0 = time.perf_counter()
+    res = simulate(m, (0.0, 14.0), "jit-dop853", rtol=1e-7, atol=1e-9, n_output=2801)
+    w = time.perf_counter() - t0
+    rows.append({"case": "flying wheelset, cone 1:40, 5 m/s, 14 s, jit-dop853 rtol 1e-7", "wall time [s]": w,
+                 "real-time factor [-]": 14.0 / w, "status": res.status})
+    m = free_wheelset(20.0, 0.001, creep_law="polach2000", track_length=300.0)
+    t0 = time.perf_counter()
+    res = simulate(m, (0.0, 12.0), "jit-dop853", rtol=1e-6, atol=1e-8, n_output=4801)
+    w = time.perf_counter() - t0
+    rows.append({"case": "flying wheelset, S1002, 20 m/s, 12 s, jit-dop853 rtol 1e-6", "wall time [s]": w,
+                 "real-time factor [-]": 12.0 / w, "status": res.status})
+    t0 = time.perf_counter()
+    lin = linear_critical_speed()
+    rows.append({"case": f"linear critical speed (bisection of eigenvalues, V_c = {lin['V_core']:.3f} m/s)",
+                 "wall time [s]": time.perf_counter() - t0, "real-time factor [-]": np.nan, "status": "finished"})
+    return pd.DataFrame(rows)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="two tolerances per method")
+    args = ap.parse_args(argv)
+    from core.results import markdown_table
+
+    RESULTS.mkdir(exist_ok=True)
+    load0 = os.getloadavg()[0]
+    wp = work_precision(args.quick)
+    rt = pd.DataFrame([real_time()])
+    tc = timed_cases()
+    load1 = os.getloadavg()[0]
+    for name, df in (("railway_vehicle_work_precision", wp), ("railway_vehicle_real_time", rt),
+                     ("railway_vehicle_timed", tc)):
+        df.to_csv(RESULTS / f"{name}.csv", index=False)
+    text = ["# Railway vehicle benchmarks", "", f"load average {load0:.2f} -> {load1:.2f}", "",
+            "## Work-precision, 5 s of curving (20 m/s, Polach 2000)", "", markdown_table(wp, floatfmt=".4g"), "",
+            "## Real-time factor, 30 s on the 200 m curve", "", markdown_table(rt.T.reset_index(), floatfmt=".4g"), "",
+            "## Timed cases", "", markdown_table(tc, floatfmt=".4g"), ""]
+    (RESULTS / "railway_vehicle.md").write_text("\n".join(text), encoding="utf-8")
+    print("\n".join(text))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

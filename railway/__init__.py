@@ -1,4 +1,4 @@
-"""Railway wheel-rail geometry, contact search and contact-geometry tables.
+"""Railway wheel-rail contact mechanics and railway vehicles on the core.
 
 Geometry half of the railway domain (the Hertz theory and the Lankarani-Nikravesh law are
 core's, :mod:`core.contact_laws`; the creep laws live in :mod:`railway.creep`):
@@ -16,8 +16,16 @@ core's, :mod:`core.contact_laws`; the creep laws live in :mod:`railway.creep`):
   of a search in one (compiled) call, with the wheel-rail helpers (curvatures by wheel and rail
   radii, the steady-rolling engagement-velocity floor);
 * :mod:`railway.two_point` -- two-point contact: conical profile, rigid onset, brute-force check;
-* :mod:`railway.quasi_static` -- wheelset position under vertical wheel loads (elastic Hertz);
-* :mod:`railway.scenes` -- scenes for ``mbsuite run``.
+* :mod:`railway.quasi_static` -- wheelset position under vertical wheel loads (elastic Hertz),
+  and rolling with the creep forces in the balance (Manchester contact benchmark);
+* :mod:`railway.assessment` -- Nadal's limit, Hertz pressure, wear number, Y/Q;
+* :mod:`railway.wheel_rail` -- the wheel-rail contact as a force element of the core (all wheels
+  of a model in one call; :mod:`railway.wheel_rail_compiled` its compiled kernels);
+* :mod:`railway.vehicle` -- vehicles from a TOML file (car body, bogies, wheelsets, suspensions),
+  static preload; :mod:`railway.traction` -- speed control along the track;
+* :mod:`railway.hunting` -- Klingel's wavelength and the critical speed of a suspended wheelset;
+* :mod:`railway.wheelset_models` -- free and suspended single-wheelset models;
+* :mod:`railway.scenes`, :mod:`railway.vehicle_scenes` -- scenes for ``mbsuite run``.
 
 SI units throughout (m, rad); mm only in profile files and CLI output.
 """
@@ -34,6 +42,8 @@ from .contact_search import ContactResult, ContactSearch, wheelset_pose
 from .forces import ContactForces
 from .profiles import RailProfile, WheelProfile, read_profile_file, s1002_exact, uic60_exact
 from .quasi_static import quasi_static_contact, quasi_static_summary
+from .vehicle import Vehicle, VehicleDefinition, build_vehicle
+from .wheel_rail import WheelRailContact, contact_history
 from .surfaces import RailSurface, WheelSurface
 from .track import (
     Curve,
@@ -59,10 +69,15 @@ __all__ = [
     "Track",
     "TrackFrame",
     "Transition",
+    "Vehicle",
+    "VehicleDefinition",
     "WheelProfile",
+    "WheelRailContact",
     "WheelSurface",
+    "build_vehicle",
     "conicity_table",
     "contact_geometry_table",
+    "contact_history",
     "contact_transitions",
     "equivalent_conicity",
     "flange_contact_onset",

@@ -298,19 +298,37 @@ if HAVE_NUMBA:
         P, G = yg.shape
         Yo = np.empty(G); Zw = np.empty(G); xi = np.empty(G); beta = np.empty(G)
         gap = np.empty(G); h4 = np.empty(G); ok = np.empty(G, dtype=np.bool_)
-        gmid = np.empty(G - 1); tt = np.empty(G - 1)
+        gmid = np.empty(G - 1); tt = np.empty(G - 1); th = np.empty(G)
         for p in range(P):
+            # the lead angle of each profile line (ContactSearch.scan_lead_angle)
+            f0 = ax[p, 1] * d[p, 2] - ax[p, 2] * d[p, 1]
+            f1 = ax[p, 2] * d[p, 0] - ax[p, 0] * d[p, 2]
+            f2 = ax[p, 0] * d[p, 1] - ax[p, 1] * d[p, 0]
+            Ac = sig[p] * (d[p, 0] * tan[p, 0] + d[p, 1] * tan[p, 1] + d[p, 2] * tan[p, 2])
+            Bc = sig[p] * (f0 * tan[p, 0] + f1 * tan[p, 1] + f2 * tan[p, 2])
+            at = ax[p, 0] * tan[p, 0] + ax[p, 1] * tan[p, 1] + ax[p, 2] * tan[p, 2]
+            Rc = np.hypot(Ac, Bc)
+            phi = np.arctan2(Bc, Ac)
             for g in range(G):
+                c = -F1g[p, g] * at / Rc
+                acs = np.arccos(min(max(c, -1.0), 1.0))
+                t1a = np.arctan2(np.sin(phi + acs), np.cos(phi + acs))
+                t2a = np.arctan2(np.sin(phi - acs), np.cos(phi - acs))
+                th[g] = t1a if abs(t1a) <= abs(t2a) else t2a
+                ct, st = np.cos(th[g]), np.sin(th[g])
+                e0 = ct * d[p, 0] + st * f0
+                e1 = ct * d[p, 1] + st * f1
+                e2 = ct * d[p, 2] + st * f2
                 w = sig[p] * (yg[p, g] + L)
-                rel0 = r[p, 0] + w * ax[p, 0] - rg[p, g] * d[p, 0] - pos[p, 0]
-                rel1 = r[p, 1] + w * ax[p, 1] - rg[p, g] * d[p, 1] - pos[p, 1]
-                rel2 = r[p, 2] + w * ax[p, 2] - rg[p, g] * d[p, 2] - pos[p, 2]
+                rel0 = r[p, 0] + w * ax[p, 0] - rg[p, g] * e0 - pos[p, 0]
+                rel1 = r[p, 1] + w * ax[p, 1] - rg[p, g] * e1 - pos[p, 1]
+                rel2 = r[p, 2] + w * ax[p, 2] - rg[p, g] * e2 - pos[p, 2]
                 Yo[g] = (rel0 * lat[p, 0] + rel1 * lat[p, 1] + rel2 * lat[p, 2]) * sig[p]
                 Zw[g] = rel0 * up[p, 0] + rel1 * up[p, 1] + rel2 * up[p, 2]
                 xi[g] = rel0 * tan[p, 0] + rel1 * tan[p, 1] + rel2 * tan[p, 2]
-                t0 = -F1g[p, g] * d[p, 0] + sig[p] * ax[p, 0]
-                t1 = -F1g[p, g] * d[p, 1] + sig[p] * ax[p, 1]
-                t2 = -F1g[p, g] * d[p, 2] + sig[p] * ax[p, 2]
+                t0 = -F1g[p, g] * e0 + sig[p] * ax[p, 0]
+                t1 = -F1g[p, g] * e1 + sig[p] * ax[p, 1]
+                t2 = -F1g[p, g] * e2 + sig[p] * ax[p, 2]
                 beta[g] = np.arctan2(t0 * up[p, 0] + t1 * up[p, 1] + t2 * up[p, 2],
                                      (t0 * lat[p, 0] + t1 * lat[p, 1] + t2 * lat[p, 2]) * sig[p])
             if side_left[p]:
@@ -349,7 +367,7 @@ if HAVE_NUMBA:
                 else:
                     jj = min(j0, G - 2)
                     tj = 1.0 if j0 == G - 1 else 0.0
-                out[rank, p, 0] = theta[p]
+                out[rank, p, 0] = theta[p] - (th[jj] + tj * (th[jj + 1] - th[jj]))
                 out[rank, p, 1] = yg[p, jj] + tj * (yg[p, jj + 1] - yg[p, jj])
                 out[rank, p, 2] = s0[p] + xi[jj] + tj * (xi[jj + 1] - xi[jj])
                 out[rank, p, 3] = ug[jj] + tj * (ug[jj + 1] - ug[jj])

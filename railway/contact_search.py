@@ -238,6 +238,34 @@ class ContactResult:
         return pd.DataFrame(cols)
 
 
+def scan_lead_angle(sig, F1, d, ax, tan):
+    r"""Angle theta (P, G) of the wheel point of each profile line whose surface normal is square
+    to the track tangent t, measured about the axle a from the lowest point direction -d.
+
+    The wheel point at profile coordinate y and angle theta is P = c + sig (y + L) a - r(y) e_r
+    with e_r = cos(theta) d + sin(theta) f, f = a x d; its normal is parallel to
+    sig e_r + F'(y) a, so the condition n . t = 0 reads
+
+    .. math:: \sigma (d\cdot t) \cos\theta + \sigma (f\cdot t) \sin\theta = -F'(y)\,(a\cdot t)
+
+    i.e. R cos(theta - phi) = C; of its two roots the one nearer the lowest point.  An unyawed
+    wheel (a . t = 0, d . t = 0) has theta = 0; a yawed one leads or lags by about
+    arctan(F' tan psi) -- a few millimetres on the tread, 16 mm ahead on a 70 deg flange at
+    12 mrad (the contact the cross-section of the lowest point would miss).
+    """
+    f = np.cross(ax, d)
+    A = sig * np.einsum("pk,pk->p", d, tan)
+    B = sig * np.einsum("pk,pk->p", f, tan)
+    C = -F1 * np.einsum("pk,pk->p", ax, tan)[:, None]
+    R = np.hypot(A, B)[:, None]
+    phi = np.arctan2(B, A)[:, None]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        acs = np.arccos(np.clip(C / R, -1.0, 1.0))
+    t1 = np.angle(np.exp(1j * (phi + acs)))
+    t2 = np.angle(np.exp(1j * (phi - acs)))
+    return np.where(np.abs(t1) <= np.abs(t2), t1, t2)
+
+
 class ContactSearch:
     """Contact search for all wheels of one or more wheelsets on a track.
 
@@ -691,13 +719,18 @@ class ContactSearch:
             if not brackets:
                 out = out[:, :, :4]
             return list(out) if listed else out[0]
+        # the point of each profile line whose normal is square to the track tangent (the
+        # contact leads or lags the lowest point of a yawed wheel): e_r = cos(th) d + sin(th) f
+        th = scan_lead_angle(sig, F1g, d, ax, tan)  # (P, G)
+        f = np.cross(ax, d)
+        e_r = np.cos(th)[:, :, None] * d[:, None, :] + np.sin(th)[:, :, None] * f[:, None, :]
         ctr = r_ws[ws][:, None, :] + (sig[:, None] * (yg + self.L))[:, :, None] * ax[:, None, :]
-        pts = ctr - rg[:, :, None] * d[:, None, :]
+        pts = ctr - rg[:, :, None] * e_r
         rel = pts - fr_pos[:, None, :]
         Yo = np.einsum("pgk,pk->pg", rel, lat) * sig[:, None]
         Zw = np.einsum("pgk,pk->pg", rel, up)
         xi = np.einsum("pgk,pk->pg", rel, tan)
-        ty = -F1g[:, :, None] * d[:, None, :] + (sig[:, None, None] * ax[:, None, :])
+        ty = -F1g[:, :, None] * e_r + (sig[:, None, None] * ax[:, None, :])
         beta = np.arctan2(np.einsum("pgk,pk->pg", ty, up),
                           np.einsum("pgk,pk->pg", ty, lat) * sig[:, None])
         ug = np.empty_like(beta)
@@ -735,7 +768,7 @@ class ContactSearch:
             def lerp(a, jj=jj, tj=tj):
                 return a[ii, jj] + tj * (a[ii, jj + 1] - a[ii, jj])
 
-            cols = [theta, lerp(yg), s_ws[ws] + lerp(xi), lerp(ug)]
+            cols = [theta - lerp(th), lerp(yg), s_ws[ws] + lerp(xi), lerp(ug)]
             if brackets:
                 G = yg.shape[1]
                 cols += [has.astype(float), yg[ii, np.maximum(jj - 1, 0)],

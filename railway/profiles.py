@@ -415,6 +415,38 @@ class WheelProfile(ProfileCurve):
                 f"{name}: need y_min <= y_flange_min < y_split < y_max, got {self.x_min}, "
                 f"{self.y_flange_min}, {self.y_split}, {self.x_max}")
 
+    @property
+    def y_flank_top(self):
+        """Top of the flank: the point of maximum flange angle nearest the flange tip (m).
+
+        The flange angle arctan|F'| is largest on the flank (70 deg on S1002's straight flank,
+        section E of EN 13715, -38.43 to -39.76 mm); beyond this point, towards the tip, it
+        falls.  A contact that has moved past it is climbing: Nadal's limit Y/Q falls with the angle, so the climb
+        goes on by itself (the derailment criterion of :class:`railway.wheel_rail.WheelRailContact`).
+        Points within 0.01 deg of the maximum count as the flank.
+        """
+        if getattr(self, "_y_flank_top", None) is None:
+            ys = np.linspace(self.y_tip, self.y_split, 4001)
+            ang = np.degrees(np.arctan(np.abs(self.poly(ys)[1])))
+            self._y_flank_top = float(ys[ang >= ang.max() - 0.01].min())
+        return self._y_flank_top
+
+    def climb_limit(self, height):
+        """Lateral coordinate (m) at which a contact has climbed ``height`` (m, radius increase)
+        above the top of the flank (:attr:`y_flank_top`); the flange tip if the flange is lower.
+        F grows monotonically from the flank top to the tip, so the root is unique (Brent)."""
+        from scipy.optimize import brentq
+
+        y0 = self.y_flank_top
+        F0 = float(self.poly(np.array([y0]))[0][0])
+
+        def rise(y):
+            return float(self.poly(np.array([y]))[0][0]) - F0 - height
+
+        if rise(self.y_tip) <= 0.0:
+            return self.y_tip
+        return float(brentq(rise, self.y_tip, y0, xtol=1e-9))
+
     def radius(self, y):
         """Wheel radius r0 + F(y) (m)."""
         return self.r0 + self.evaluate(y)[0]

@@ -137,8 +137,11 @@ core's :func:`~core.analysis.linearize` / :func:`~core.analysis.eigen` apply (sc
 Loss of contact and derailment
 ------------------------------
 A wheel that lifts off has no penetration and gets zero force.  After every accepted step the
-kind checks that every wheel still runs on its rail: a contact within ``flange_tip_margin`` of
-the flange tip (the flange has climbed onto the rail crown), or a wheelset whose lateral
+kind checks that every wheel still runs on its rail: a loaded contact that has climbed more
+than ``flange_climb_height`` (radius increase, default 5 mm) above the top of the flank -- the
+point of maximum flange angle, :attr:`railway.profiles.WheelProfile.y_flank_top`, beyond which
+Nadal's limit Y/Q falls with the contact angle, so that the climb goes on by itself -- or a
+wheelset whose lateral
 displacement exceeds ``max_lateral_displacement`` or whose centre sank more than
 ``max_drop`` below its nominal height (it left the rail), ends the run with status ``failed``,
 the time, the wheel and its last Y/Q (the integrators catch the :class:`NumericalFailure` raised
@@ -216,8 +219,9 @@ class WheelRailContact(ForceElement):
         path only.
     reseed_every : int
         Global re-seeding of the tracked contacts every this many accepted steps (default 1).
-    flange_tip_margin, max_lateral_displacement, max_drop : float
-        Derailment criteria (m): contact within this distance of the flange tip; lateral
+    flange_climb_height, max_lateral_displacement, max_drop : float
+        Derailment criteria (m): a loaded contact this high (radius increase) above the top
+        of the flank (the point of maximum flange angle); lateral
         displacement of a wheelset from the track centre; drop of a wheelset centre below
         its nominal height r0 above the rail tops.
     """
@@ -238,7 +242,7 @@ class WheelRailContact(ForceElement):
     rail_body: Any = None
     nominal_spin: Any = None
     reseed_every: int = 1
-    flange_tip_margin: float = 1e-3
+    flange_climb_height: float = 5e-3
     max_lateral_displacement: float = 0.05
     max_drop: float = 0.03
 
@@ -285,7 +289,7 @@ class _Set:
             v = getattr(e, key)
             if not (isinstance(v, (int, np.integer)) and v >= 1):
                 raise ModelError(f"wheel-rail contact {e.name!r}: {key} = {v!r} must be a positive integer")
-        for key in ("flange_tip_margin", "max_lateral_displacement", "max_drop"):
+        for key in ("flange_climb_height", "max_lateral_displacement", "max_drop"):
             v = float(getattr(e, key))
             if not (np.isfinite(v) and v > 0):
                 raise ModelError(f"wheel-rail contact {e.name!r}: {key} = {v!r} m must be positive")
@@ -312,6 +316,11 @@ class _Set:
         except ValueError as exc:
             raise ModelError(f"wheel-rail contact {e.name!r}: {exc}") from None
         self.wheel = wheel
+        # derailment: a loaded contact beyond y_climb, i.e. higher than climb_height above the
+        # top of the flank (F grows monotonically from there to the tip)
+        self.y_climb = wheel.climb_limit(e.flange_climb_height)
+        self.climb_height = float(wheel.evaluate(np.array([self.y_climb]))[0][0]
+                                  - wheel.evaluate(np.array([wheel.y_flank_top]))[0][0])
         self.n_ws = len(names)
         self.state: _State | None = None
         # wheelsets must have their y axis along the track's lateral direction at build
@@ -781,7 +790,7 @@ def _wheel_quantities(st, res, f, r, Ans, s, w):
         "Nadal limit [-]": lim.ravel(), "contact angle [rad]": np.where(np.isfinite(gmax), gmax, np.nan).ravel(),
         "p_max [Pa]": np.maximum(pmax, pmax2).max(axis=2).ravel(), "T gamma [N]": Tg.sum(axis=2).ravel(),
         "y_wheel [m]": res.y_wheel.reshape(n_ws, 2, 2)[..., 0].ravel(),
-        "flange tip distance [m]": _tip_distance(st, res).ravel(),
+        "flange climb [m]": _flange_climb(st, res).ravel(),
     }
     contacts = {
         "N [N]": N, "Fx [N]": f["Fx"].reshape(n_ws, 2, 2), "Fy [N]": f["Fy"].reshape(n_ws, 2, 2),
@@ -800,12 +809,29 @@ def _wheel_quantities(st, res, f, r, Ans, s, w):
             "wheelsets": wheelsets}
 
 
-def _tip_distance(st, res):
-    """Distance (m) of each wheel's flange-candidate contact from the flange tip, along the
-    profile coordinate (inf where the flange candidate has no contact)."""
-    yf = res.y_wheel[:, 1]
-    loaded = res.valid[:, 1] & (res.penetration[:, 1] > 0)
-    return np.where(loaded, yf - st.wheel.y_tip, np.inf)
+def _flange_climb(st, res):
+    """Height (m, radius increase) of each wheel's highest penetrating contact above the top of the
+    flank (:attr:`railway.profiles.WheelProfile.y_flank_top`); 0 for a wheel whose penetrating
+    contacts are all on the flank, its root or the tread."""
+    res2 = res.extra["secondary"]
+    with np.errstate(invalid="ignore"):
+        y = np.concatenate([np.where(res.valid & (res.penetration > 0), res.y_wheel, np.nan),
+                            np.where(res2.valid & (res2.penetration > 0), res2.y_wheel, np.nan)], axis=1)
+    y_top = st.wheel.y_flank_top
+    y_min = np.where(np.isnan(y), np.inf, y).min(axis=1)
+    climbed = y_min < y_top
+    F_top = st.wheel.evaluate(np.array([y_top]))[0][0]
+    h = np.zeros(y.shape[0])
+    if np.any(climbed):
+        h[climbed] = st.wheel.evaluate(y_min[climbed])[0] - F_top
+    return h.reshape(st.n_ws, 2)
+
+
+def climb_message(wheel_label, element, climb, profile, criterion, last):
+    """The failure message of a flange-climb derailment (both paths)."""
+    return (f"derailment of wheel {wheel_label!r} ({element}): flange climb -- its contact is "
+            f"{climb * 1e3:.2f} mm (radius increase) above the top of the flank, the point of maximum "
+            f"flange angle at y = {profile.y_flank_top * 1e3:.2f} mm (criterion {criterion * 1e3:g} mm); {last}")
 
 
 def _check_derailment(st, res, out, last_YQ):
@@ -819,13 +845,11 @@ def _check_derailment(st, res, out, last_YQ):
         v = last_YQ[i] if last_YQ.size else np.nan
         return f"last Y/Q {v:.3g} at the previous accepted step, {yq[i]:.3g} now"
 
-    tip = wh["flange tip distance [m]"]
-    if np.any(tip < e.flange_tip_margin):
-        i = int(np.argmin(tip))
-        raise NumericalFailure(
-            f"derailment of wheel {labels[i]!r} ({e.name}): its flange contact is {tip[i] * 1e3:.2f} mm "
-            f"from the flange tip (the flange climbed onto the rail; criterion "
-            f"{e.flange_tip_margin * 1e3:g} mm); {last(i)}")
+    climb = wh["flange climb [m]"]
+    if np.any(climb > st.climb_height):
+        i = int(np.argmax(climb))
+        raise NumericalFailure(climb_message(labels[i], e.name, climb[i], st.wheel, e.flange_climb_height,
+                                             last(i)))
     y = wss["lateral displacement [m]"]
     drop = st.wheel.r0 - wss["height [m]"]
     bad = (np.abs(y) > e.max_lateral_displacement) | (drop > e.max_drop)

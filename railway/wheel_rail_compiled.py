@@ -51,7 +51,7 @@ from core.compiled.protocol import (
 
 from ._kernels import newton, ppeval, reduced_min, scan
 from .forces import kernel as contact_forces
-from .wheel_rail import BLEND_GAP, SEPARATION
+from .wheel_rail import BLEND_GAP, SEPARATION, climb_message
 
 __all__ = ["compile_wheel_rail", "describe_failure"]
 
@@ -99,7 +99,7 @@ K_WTS = 29
 K_SCAL = 30
 K_CP = 31
 # scalars of segment "scal"
-(SC_TOL, SC_T0, SC_DT, SC_KSUM, SC_G, SC_MU, SC_CHI, SC_V0, SC_MAXPEN, SC_YSPLIT, SC_YTIP, SC_TIP,
+(SC_TOL, SC_T0, SC_DT, SC_KSUM, SC_G, SC_MU, SC_CHI, SC_V0, SC_MAXPEN, SC_YSPLIT, SC_YTIP, SC_YCLIMB,
  SC_MAXLAT, SC_MAXDROP, SC_R0, SC_LENGTH, SC_CLOSED, SC_LW) = range(18)
 # --- state header -----------------------------------------------------------------------------
 ST_ACC, ST_FAIL, ST_IDX, ST_V1, ST_YQ0, ST_YQ1, ST_V2 = range(7)
@@ -728,10 +728,11 @@ def wheel_rail_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
         vb, gb, Sb, Vb = _both(valid, gap, S, V, valid2, gap2, S2, V2)
         out, Fg, Mg, vmin = _forces(fd, ix, e, vb, gb, Sb, Vb, rws, vws, wws, Ans)
         _weigh_second(Sb, gb, out, Fg, Mg, P)
-        # per wheel: Y/Q (module docstring of railway.wheel_rail), flange tip distance; per
-        # wheelset: lateral displacement and drop.  The checks in the numpy kind's order:
-        # flange climb first, then a wheelset that left the rails.
-        worst_tip, worst_w = np.inf, -1
+        # per wheel: Y/Q (module docstring of railway.wheel_rail), the highest penetrating
+        # contact on the flange (lowest y_wheel); per wheelset: lateral displacement and drop.
+        # The checks in the numpy kind's order: flange climb first, then a wheelset that left
+        # the rails.
+        worst_y, worst_w = np.inf, -1
         left_k, left_lat, left_drop = -1, 0.0, 0.0
         yq_now = np.empty(2 * n_ws)
         f_inner, f_breaks = _seg1(fd, ix, e, K_F_INNER), _seg1(fd, ix, e, K_F_BREAKS)
@@ -747,20 +748,19 @@ def wheel_rail_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
                     Fy += Fg[p, 0] * o[4] + Fg[p, 1] * o[7] + Fg[p, 2] * o[10]
                 Y = -Fy * (1.0 if side == 0 else -1.0)
                 yq_now[wi] = Y / Fz if Fz > 0.0 else np.nan
-                pf = 4 * k + 2 * side + 1
-                if valid[pf] and gap[pf] < 0.0:
-                    tip = S[pf, 1] - sc[SC_YTIP]
-                    if tip < worst_tip:
-                        worst_tip, worst_w = tip, wi
+                for c in range(4):
+                    p = 4 * k + 2 * side + c if c < 2 else P + 4 * k + 2 * side + c - 2
+                    if vb[p] and gb[p] < 0.0 and Sb[p, 1] < worst_y:
+                        worst_y, worst_w = Sb[p, 1], wi
             e0, e1, e2 = rws[k, 0] - o[0], rws[k, 1] - o[1], rws[k, 2] - o[2]
             lat_d = e0 * o[4] + e1 * o[7] + e2 * o[10]
             drop = sc[SC_R0] - (e0 * o[5] + e1 * o[8] + e2 * o[11])
             if left_k < 0 and (abs(lat_d) > sc[SC_MAXLAT] or drop > sc[SC_MAXDROP]):
                 left_k, left_lat, left_drop = k, lat_d, drop
-        if worst_tip < sc[SC_TIP]:
+        if worst_y < sc[SC_YCLIMB]:
             row[ST_FAIL] = FAIL_FLANGE_CLIMB
             row[ST_IDX] = worst_w
-            row[ST_V1] = worst_tip
+            row[ST_V1] = worst_y
             row[ST_YQ0] = yq_prev[worst_w]
             row[ST_YQ1] = yq_now[worst_w]
             err[1] = e
@@ -808,10 +808,11 @@ def describe_failure(kind, state) -> str:
         i = int(row[ST_IDX])
         if code == FAIL_FLANGE_CLIMB:
             wheel = f"{st.wheelset_names[i // 2]} {('left', 'right')[i % 2]}"
-            return (f"derailment of wheel {wheel!r} ({st.name}): its flange contact is {row[ST_V1] * 1e3:.2f} mm "
-                    f"from the flange tip (the flange climbed onto the rail; criterion "
-                    f"{st.e.flange_tip_margin * 1e3:g} mm); last Y/Q {row[ST_YQ0]:.3g} at the previous "
-                    f"accepted step, {row[ST_YQ1]:.3g} now")
+            w = st.wheel
+            climb = float(w.evaluate(np.array([row[ST_V1]]))[0][0] - w.evaluate(np.array([w.y_flank_top]))[0][0])
+            return climb_message(wheel, st.name, climb, w, st.e.flange_climb_height,
+                                 f"last Y/Q {row[ST_YQ0]:.3g} at the previous accepted step, "
+                                 f"{row[ST_YQ1]:.3g} now")
         if code == FAIL_LEFT_RAILS:
             wheel = f"{st.wheelset_names[i // 2]} {('left', 'right')[i % 2]}"
             return (f"derailment of wheelset {st.wheelset_names[i // 2]!r} ({st.name}): it left the rails "
@@ -840,8 +841,7 @@ def _segments(st):
     sc[SC_T0], sc[SC_DT], sc[SC_KSUM], sc[SC_G] = cf._t0, cf._dt, cf._ksum, cf.G
     sc[SC_MU], sc[SC_CHI], sc[SC_V0] = cf.mu, cf._chi, cf.v0
     sc[SC_MAXPEN], sc[SC_YSPLIT], sc[SC_YTIP] = cs.max_penetration, st.wheel.y_split, st.wheel.y_tip
-    sc[SC_TIP], sc[SC_MAXLAT], sc[SC_MAXDROP] = (st.e.flange_tip_margin, st.e.max_lateral_displacement,
-                                                  st.e.max_drop)
+    sc[SC_YCLIMB], sc[SC_MAXLAT], sc[SC_MAXDROP] = st.y_climb, st.e.max_lateral_displacement, st.e.max_drop
     sc[SC_R0], sc[SC_LENGTH] = st.wheel.r0, st.track.length
     sc[SC_CLOSED] = 1.0 if getattr(st.track, "closed", False) else 0.0
     sc[SC_LW] = cs.L
@@ -859,6 +859,7 @@ def _state_row(st) -> np.ndarray:
     n_ws = st.n_ws
     P = 4 * n_ws
     row = np.zeros(ST_HEAD + 8 * P + n_ws + P + 2 * n_ws)
+    row[-2 * n_ws:] = np.nan  # last Y/Q: none yet
     s = st.state
     if s is None:
         return row
@@ -870,7 +871,7 @@ def _state_row(st) -> np.ndarray:
     a += n_ws
     row[a:a + P] = s.valid.astype(float)
     a += P
-    row[a:a + 2 * n_ws] = np.nan_to_num(s.last_YQ, nan=0.0) if s.last_YQ.size else 0.0
+    row[a:a + 2 * n_ws] = s.last_YQ if s.last_YQ.size else np.nan  # NaN: a lifted wheel, or none yet
     return row
 
 

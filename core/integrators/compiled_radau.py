@@ -986,7 +986,7 @@ class CompiledRadau(Integrator):
             why = (f"coordinate projection did not reach ‖Φ‖ ≤ {self.projection_tol:g} in "
                    f"{self.max_projection_iter} iterations at t = {info[3]:.6g} s")
         else:
-            why = f"{self._status_message(code)} at t = {info[3]:.6g} s"
+            why = f"{self._status_message(code)} (in the step to t = {info[3]:.6g} s)"
         self.status = STATUS_FAILED
         self.t = max(t_before, self.t)
         self.message = f"{self.name} failed at t = {self.t:.6g} s: {why}"

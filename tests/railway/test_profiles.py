@@ -62,6 +62,15 @@ def test_s1002_zones(s1002):
     assert s1002.y_split == pytest.approx(-0.0384267, abs=5e-5)
     _, d1, d2 = s1002.evaluate(np.linspace(s1002.y_tip, s1002.y_split - 1e-5, 200))
     assert np.all(d2 <= 1e-6)  # convex flange
+    # the top of the 70 deg flank: the end of section E of the definition (y = -39.7642 mm),
+    # to the 0.01 deg tolerance of WheelProfile.y_flank_top (1.2 um on the R20 arc F, plus
+    # the 3.8 um grid of the search)
+    assert s1002.y_flank_top == pytest.approx(-0.0397642, abs=6e-6)
+    # 5 mm above it: on arc F, F(y) - F(top) = 5 mm from the section's closed form
+    y5 = s1002.climb_limit(5e-3)
+    def arc_f(y):  # section F, mm
+        return 8.834924130 + np.sqrt(20.0**2 - (y + 58.558326413) ** 2)
+    assert arc_f(y5 * 1e3) - arc_f(-39.7642) == pytest.approx(5.0, abs=0.02)  # 2.75 x 6 um
 
 
 def test_uic60_arc_tangency():

@@ -6,7 +6,8 @@ from core.scenes import Scene, run_scene
 from railway.scenes import railway_scenes
 
 NAMES = ["railway-contact-geometry", "railway-creep-curves", "railway-two-point-contact",
-         "railway-manchester-contact"]
+         "railway-manchester-contact", "railway-flying-wheelset", "railway-critical-speed", "railway-curving",
+         "railway-irregular-track"]
 
 
 def test_scene_list():
@@ -35,3 +36,16 @@ def test_geometry_scenes_fast(tmp_path, name):
     res = run_scene(scene, tmp_path, fast=True)
     assert res.tables and res.figures
     assert (tmp_path / name / "README.md").exists()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["railway-flying-wheelset", "railway-critical-speed", "railway-curving",
+                                  "railway-irregular-track"])
+def test_vehicle_scenes_fast(tmp_path, name):
+    """The vehicle scenes' fast variants write their tables, figures and README."""
+    scene = {s.name: s for s in railway_scenes()}[name]
+    res = run_scene(scene, tmp_path, fast=True)
+    assert res.tables and res.figures
+    assert (tmp_path / name / "README.md").exists()
+    for table in res.tables.values():
+        assert len(table) > 0

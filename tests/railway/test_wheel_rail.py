@@ -164,9 +164,10 @@ def test_a_lifted_wheelset_has_no_contact_force_and_lands():
 
 
 @pytest.mark.parametrize("method", ["rk45", "jit-dop853"])
-def test_a_wheelset_pushed_over_the_flange_ends_failed_naming_the_wheel(method):
-    # a lateral force of 40 kN to the right on a wheelset carrying 17.8 kN: Y/Q of the right
-    # wheel far above Nadal's limit (1.35 at 70 deg, mu = 0.3): the flange climbs the rail
+def test_a_wheelset_pushed_off_the_rails_ends_failed_naming_the_wheel(method):
+    # a lateral force of 40 kN to the right at the centre of a wheelset carrying 17.8 kN: its
+    # moment about the right rail (40 kN x 0.46 m) exceeds the weight's (17.8 kN x 0.75 m), so
+    # the wheelset tips over the right rail and leaves it
     m = wheelset_model(y0=0.0, creep_law="polach2000",
                        extra=lambda b: b.add_applied_force("push", "ws", (0.0, 0.0, 0.0), (0.0, -40e3, 0.0)))
     res = simulate(m, (0.0, 1.0), method, rtol=1e-4, atol=1e-6)
@@ -176,6 +177,24 @@ def test_a_wheelset_pushed_over_the_flange_ends_failed_naming_the_wheel(method):
     # the run keeps what it computed: lateral displacement up to the failure
     y = res.coordinates()["ws.y [m]"].to_numpy()
     assert np.all(np.isfinite(y)) and y[-1] < -0.006
+
+
+@pytest.mark.parametrize("method", ["rk45", "jit-dop853"])
+def test_a_flange_that_has_climbed_ends_the_run_naming_the_wheel(method):
+    """Rigid contact with the wheelset 12 mm to the right: the right flange touches its rail
+    46.1 mm from the taping line, on the flange tip arc above the 70 deg flank (which ends at
+    -39.76 mm), more than the 5 mm criterion higher -- flange climb.  At 5 mm (short of the
+    flange onset at 6.25 mm) the same run goes on."""
+    from railway.contact_geometry import rigid_contact
+
+    z, _, res0, *_ = rigid_contact([-0.012])
+    assert res0.y_wheel[1, 1] < -0.046  # the right wheel's flange contact of the rigid pose
+    m = wheelset_model(y0=-0.012, creep_law="polach2000")
+    res = simulate(m, (0.0, 0.05), method, rtol=1e-4, atol=1e-6)
+    assert res.status == "failed"
+    assert "flange climb" in res.message and "'ws right'" in res.message and "Y/Q" in res.message
+    ok = simulate(wheelset_model(y0=-0.005, creep_law="polach2000"), (0.0, 0.05), method, rtol=1e-4, atol=1e-6)
+    assert ok.success, ok.message
 
 
 # ---------------------------------------------------------------------------------------------
@@ -284,3 +303,24 @@ def test_vehicle_file_errors_name_the_file_and_key(tmp_path):
         VehicleDefinition.from_toml(bad)
     with pytest.raises(DataFileError, match="does not exist"):
         VehicleDefinition.from_toml(tmp_path / "none.toml")
+
+
+def test_a_vehicle_file_with_yaw_dampers_builds_settles_and_runs(tmp_path):
+    """The usual extras from the file: yaw dampers with series stiffness (Maxwell elements with
+    a node mass), bump stops and the anti-roll bar; the preload still gives each wheel its
+    share, and the dampers carry no static force."""
+    src = Path(VehicleDefinition.manchester().path).read_text(encoding="utf-8")
+    f = tmp_path / "coach_with_yaw_dampers.toml"
+    f.write_text(src + "\n[[yaw_damper]]\ndamping = 300e3\nseries_stiffness = 6e6\nnode_mass = 5.0\n"
+                 "x = 1.5\ny = 1.2\nz = 0.8\n", encoding="utf-8")
+    D = VehicleDefinition.from_toml(f)
+    assert len(D.yaw_dampers) == 1
+    veh = build_vehicle(D, Track.straight(300.0), s0=30.0, speed=20.0)
+    names = [n for k in veh.model.force_kinds for n in k.names]
+    assert sum(n.startswith("yaw damper") for n in names) == 4  # two per bogie
+    assert sum(n.startswith("lateral bump stop") for n in names) == 2
+    table = veh.preload()
+    np.testing.assert_allclose(table["Q [N]"], D.total_mass * GRAVITY / 8.0, rtol=1e-6)
+    q0, v0 = veh.initial_state(wheelset_lateral=[0.002, 0, 0, 0])
+    res = simulate(veh.model, (0.0, 0.2), "jit-radau", q0=q0, v0=v0, rtol=1e-4, atol=1e-6)
+    assert res.success, res.message

@@ -3,7 +3,7 @@
 Commands::
 
     mbsuite list                              scenes with their titles
-    mbsuite run NAME [NAME ...] [-o OUT] [--fast]
+    mbsuite run NAME [NAME ...] [-o OUT] [--fast] [--workers N | --dask ADDRESS]
     mbsuite run --all [-o OUT] [--fast]       every scene, into OUT/<scene name>/
     mbsuite bench [PROBLEM ...] [--methods M ...] [--repeats N] [--quick|--full] [-j N] [-o OUT]
     mbsuite bench --list                      work-precision problems and methods (core.benchmarks)
@@ -28,7 +28,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from . import __version__
-from .errors import MbsuiteError
+from .errors import InputError, MbsuiteError
 from .paths import output_folder
 from .scenes import Scene, SceneError, all_scenes, run_scene, tqdm_progress
 
@@ -86,6 +86,42 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     out_dir = output_folder(args.out)
+    with _sweep_executor(args) as executor:
+        return _run_selected(selected, out_dir, args, executor, tqdm)
+
+
+def _sweep_executor(args: argparse.Namespace):
+    """The executor of the scenes' sweeps: serial (None), a local process pool (``--workers N``)
+    or a dask.distributed cluster (``--dask ADDRESS``, extra ``mbsuite[parallel]``)."""
+    import contextlib
+    import concurrent.futures
+
+    if args.workers is not None and args.dask is not None:
+        raise InputError("give --workers or --dask, not both")
+    if args.workers is not None:
+        if args.workers < 1:
+            raise InputError(f"--workers {args.workers}: give a number of processes >= 1")
+        return concurrent.futures.ProcessPoolExecutor(max_workers=args.workers)
+    if args.dask is not None:
+        try:
+            from dask.distributed import Client
+        except ImportError:
+            raise InputError("--dask needs dask.distributed: pip install 'mbsuite[parallel]'") from None
+
+        @contextlib.contextmanager
+        def _client():
+            try:
+                client = Client(args.dask, timeout=30)
+            except OSError as exc:
+                raise InputError(f"--dask {args.dask}: cannot connect to the scheduler ({exc})") from None
+            with client:
+                yield client.get_executor()
+
+        return _client()
+    return contextlib.nullcontext(None)
+
+
+def _run_selected(selected, out_dir, args, executor, tqdm) -> int:
     outcomes: dict[str, tuple[Scene, str]] = {}
     failed: list[str] = []
     bar = tqdm(selected, desc="scenes", unit="scene", disable=None)
@@ -93,7 +129,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
         bar.set_postfix_str(scene.name)
         start = time.perf_counter()
         try:
-            result = run_scene(scene, out_dir, fast=args.fast, progress=tqdm_progress)
+            result = run_scene(scene, out_dir, fast=args.fast, progress=tqdm_progress, executor=executor)
         except SceneError as exc:
             failed.append(scene.name)
             outcomes[scene.name] = (scene, "failed")
@@ -218,6 +254,11 @@ def build_parser() -> argparse.ArgumentParser:
     p_run.add_argument("--all", action="store_true", help="run every available scene")
     p_run.add_argument("-o", "--out", default="out", help="output folder (default: %(default)s)")
     p_run.add_argument("--fast", action="store_true", help="reduced resolution (smoke test)")
+    p_run.add_argument("--workers", type=int, default=None, metavar="N",
+                       help="run the scenes' parameter sweeps on N local processes (default: serial)")
+    p_run.add_argument("--dask", default=None, metavar="ADDRESS",
+                       help="run the scenes' parameter sweeps on a dask.distributed scheduler "
+                            "(e.g. tcp://host:8786; extra mbsuite[parallel])")
     p_run.set_defaults(func=_cmd_run, _parser=p_run)
 
     register_bench_command(sub)

@@ -100,11 +100,15 @@ class SceneContext:
         ``progress(iterable, **tqdm_kwargs)`` wraps loops in a progress bar.
     fast : bool, optional
         Reduced resolution (shorter spans, fewer cases) for tests and smoke runs.
+    executor : concurrent.futures.Executor, optional
+        Where a scene's parameter sweep runs (:func:`core.sweep.run_sweep`); None (default) runs
+        it serially in this process, the reference result.
     """
 
     out_dir: Path
     progress: Callable[..., Iterable[Any]] = tqdm_progress
     fast: bool = False
+    executor: Any = None
 
 
 @dataclass
@@ -249,6 +253,7 @@ def run_scene(
     out_dir: str | Path,
     fast: bool = False,
     progress: Callable[..., Iterable[Any]] = tqdm_progress,
+    executor: Any = None,
 ) -> SceneResult:
     """Run one scene and write its tables, figures and README into ``out_dir/<name>/``.
 
@@ -262,6 +267,8 @@ def run_scene(
         Passed on as ``ctx.fast``.
     progress : callable, optional
         Passed on as ``ctx.progress``.
+    executor : concurrent.futures.Executor, optional
+        Passed on as ``ctx.executor`` (sweeps inside the scene).
 
     Returns
     -------
@@ -284,7 +291,7 @@ def run_scene(
     # file has a new inode and time stamp)
     earlier = {p: _identity(p) for p in folder.iterdir() if p.is_file() and p.name != "error.txt"}
     try:
-        result = scene.run(SceneContext(out_dir=folder, progress=progress, fast=fast))
+        result = scene.run(SceneContext(out_dir=folder, progress=progress, fast=fast, executor=executor))
         if not isinstance(result, SceneResult):
             raise TypeError(f"scene {scene.name!r} returned {type(result).__name__}, expected SceneResult")
         written: dict[str, list[Path]] = {"tables": [], "figures": []}

@@ -286,6 +286,11 @@ if HAVE_NUMBA:
             S[pi, 8] = -F2 / wq**1.5
             S[pi, 9] = -dot(n, qss) / dot(ts, ts)
             S[pi, 10] = -v2 / (1.0 + v1 * v1) ** 1.5
+            # a stationary point is a contact only where the gap has a minimum across the
+            # profiles: relative lateral curvature B = (k_wheel_lat + k_rail_lat)/2 > 0
+            # (ContactSearch._newton, "Saddles are not contacts")
+            if not (S[pi, 8] + S[pi, 10] > 0.0):
+                conv[pi] = False
             for k in range(3):
                 V[pi, 0, k] = p[k]; V[pi, 1, k] = q[k]; V[pi, 2, k] = n[k]
         return X, H0, conv, max_it, GAP, S, V

@@ -647,7 +647,23 @@ class ContactSearch:
         if self.jacobian == "analytic" and np.any(dx_fin):
             x = x + dx_fin
             info_all = self._linear_update(info_all, dx_fin)
+        conv &= self._minimum(info_all)
         return x, H0_all, conv, it, info_all
+
+    @staticmethod
+    def _minimum(info):
+        """Saddles are not contacts: a converged stationary point of the gap is a contact only
+        where the gap has a minimum across the profiles, i.e. where the relative lateral
+        curvature B = (k_wheel_lateral + k_rail_lateral)/2 is positive.  Where a concave wheel
+        profile is more curved than the convex rail head under it (B < 0: e.g. the S1002 tread
+        near 6 mm inboard of the taping line, radius 234 mm, on the UIC60 R300 crown) the
+        stationary point is a maximum of the gap along the profile between two minima -- the
+        contacts lie at those minima.  Hertz has no meaning there (its ellipse would be
+        clipped to an elongated one, with semi-axes of decimetres and forces of hundreds of kN
+        from micrometres of penetration)."""
+        F1, F2, v1, v2 = info["F1"], info["F2"], info["v1"], info["v2"]
+        B = 0.5 * (-F2 / (1.0 + F1**2) ** 1.5 - v2 / (1.0 + v1**2) ** 1.5)
+        return B > 0.0
 
     def _newton_compiled(self, x, pc, r_ws, AP, max_iter):
         """The same Newton iteration in the compiled kernel of :mod:`railway._kernels`."""

@@ -37,9 +37,10 @@ Two implementations, tested against each other:
   against t = ln(B/A) on a uniform grid of 4001 nodes (linear interpolation; relative error
   below 1e-4 against the exact bisection and table interpolation, see the tests).  Its normal
   law is Eq. (N1) of :mod:`core.contact_laws` written for numba (tested to agree with
-  :func:`core.contact_laws.hysteresis_force`).  It implements only the creep laws
-  ``kalker_linear`` and ``polach2000`` (with the default ``join="scaled"``); every other law
-  runs on the reference path (``compiled="auto"``) -- a law is never replaced by another.
+  :func:`core.contact_laws.hysteresis_force`).  It implements every creep law of the package
+  (Kalker linear, Polach 2000, Shen–Hedrick–Elkins, Polach 2005, FASTSIM; the exact classes with
+  the default ``join="scaled"``, see :func:`_kernel_code`); subclasses and user laws run on the
+  reference path (``compiled="auto"``) -- a law is never replaced by another.
 
 Conformal contacts (the concave S1002 flange root on the gauge corner) are not Hertzian (B <= 0);
 both implementations clip the curvature ratio B/A to [1/rho_max, rho_max] (rho_max = 1e3) and so

@@ -867,9 +867,12 @@ def contact_history(model, result, element=None, wheels=None):
     """Per output time and wheel, what a railway engineer reads (long format).
 
     The outputs of :meth:`WheelRailKind.contact_outputs` are evaluated at the stored states of
-    ``result``, replaying the search state along the output times (reset at the first row, the
-    accept hook after every row), so that the contacts found are those a run with these
-    output times as its steps would have tracked.
+    ``result`` with a fresh search state at every row (the global cross-section scan and the
+    robust refinement of :meth:`WheelRailKind.reset_state`), so that every row depends on its
+    (t, q, v) alone.  (Replaying the tracked state along the output times instead would track
+    the contacts over the output interval -- 50 ms, a metre of track at 20 m/s -- and lose a
+    patch where a tracked point runs onto a saddle of the gap; the run itself re-seeds after
+    every accepted step.)
 
     Returns
     -------
@@ -891,8 +894,7 @@ def contact_history(model, result, element=None, wheels=None):
     try:
         for i, t in enumerate(result.t):
             bs = model.body_states(result.q[i], result.v[i])
-            if i == 0:
-                kind.reset_state(bs, float(t))
+            kind.reset_state(bs, float(t))
             out = kind.contact_outputs(bs, float(t), st.name)
             r, A, v, w = st.states(bs)
             speed = np.einsum("nk,nk->n", v, st.track.evaluate_raw(np.nan_to_num(out["wheelsets"]["s [m]"]))[3][:, :, 0])
@@ -908,8 +910,6 @@ def contact_history(model, result, element=None, wheels=None):
                 row[k] = np.repeat(np.asarray(v_), 2)
             row["speed [m/s]"] = np.repeat(speed, 2)
             rows.append(pd.DataFrame(row))
-            if i + 1 < len(result.t):
-                kind.accept_step(bs, float(t), reseed=True)
     finally:
         st.state = saved
     df = pd.concat(rows, ignore_index=True)

@@ -118,6 +118,29 @@ def test_run_one_scene_writes_tables_figures_readme(registry, tmp_path, capsys):
     assert "ok-scene" in (tmp_path / "README.md").read_text()
 
 
+def _sweep_scene(ctx):
+    from core.sweep import run_sweep
+
+    squares = run_sweep(abs, [-1, -2, -3], executor=ctx.executor)
+    kind = type(ctx.executor).__name__
+    return SceneResult(tables={"sweep": pd.DataFrame({"x": squares, "executor": kind})})
+
+
+def test_run_passes_the_sweep_executor_to_the_scenes(registry, tmp_path, capsys):
+    scenes.register_scene(Scene("sweep-scene", "A sweep", "", _sweep_scene))
+    assert cli.main(["run", "sweep-scene", "-o", str(tmp_path / "serial")]) == 0
+    assert cli.main(["run", "sweep-scene", "-o", str(tmp_path / "pool"), "--workers", "2"]) == 0
+    serial = pd.read_csv(tmp_path / "serial" / "sweep-scene" / "sweep.csv")
+    pool = pd.read_csv(tmp_path / "pool" / "sweep-scene" / "sweep.csv")
+    assert serial["x"].tolist() == pool["x"].tolist() == [1, 2, 3]
+    assert serial["executor"].iloc[0] == "NoneType"
+    assert pool["executor"].iloc[0] == "ProcessPoolExecutor"
+    capsys.readouterr()
+    assert cli.main(["run", "sweep-scene", "-o", str(tmp_path), "--workers", "0"]) == 2
+    assert "--workers 0" in capsys.readouterr().err
+    assert cli.main(["run", "sweep-scene", "-o", str(tmp_path), "--workers", "2", "--dask", "x"]) == 2
+
+
 def test_run_all_continues_after_failure_and_exits_nonzero(registry, tmp_path, capsys):
     assert cli.main(["run", "--all", "-o", str(tmp_path)]) == 1
     err = capsys.readouterr().err

@@ -284,3 +284,36 @@ def test_compiled_seed_scan_equals_numpy():
         b = ref._seed_scan(ref._problems, r, A, s, second=True)
         for x, y in zip(a, b):
             np.testing.assert_allclose(x, y, rtol=0, atol=1e-12)
+
+
+def test_saddles_of_the_gap_are_not_contacts(setup):
+    """Between two minima of the S1002 tread gap on the UIC60 crown the gap has a maximum along
+    the profile, where the concave tread (radius ~ 234 mm some 6 mm inboard of the taping line)
+    is more curved than the R300 crown: relative lateral curvature B < 0.  Newton seeded near
+    it converges to that stationary point; it is refused (before, it was taken as a contact,
+    with a clipped Hertz ellipse of decimetres and, in a vehicle run on irregular track, 351 kN
+    from 45 um of penetration).  Every contact returned is a minimum (B > 0) and the lowest is
+    the brute-force minimum distance."""
+    track, wheel, mount = setup
+    cs = ContactSearch(track, wheel=wheel, rails=mount)
+    r, A = wheelset_pose(track, 10.0, -9e-5, R0 + 3e-3, 0.0, 0.0)
+    base = cs.scan_seeds(r, A, [10.0])[0][:, :4]
+    saddles, minima = set(), []
+    for y in np.linspace(-0.0075, -0.005, 11):
+        seeds = base.copy()
+        seeds[0, 3] += y - seeds[0, 1]  # left wheel, tread: the rail point moved along
+        seeds[0, 1] = y
+        res, x_all, _, _ = cs.solve([seeds], r, A, [10.0])
+        B = 0.5 * (res.k_wheel_lateral + res.k_rail_lateral)[0, 0]
+        if res.valid[0, 0]:
+            assert B > 0.0, y
+            minima.append(res.gap[0, 0])
+        elif res.residual[0, 0] < 1e-9:  # Newton converged, to a saddle, and it was refused
+            saddles.add(round(float(x_all[0, 0, 1]), 7))
+    assert len(saddles) == 1  # one saddle, reached from several seeds
+    assert minima  # the local minimum beyond it (the rail's R80 shoulder side)
+    g_brute = brute_force_gap(wheel, mount, r[0], A[0], 1)
+    assert min(minima) >= g_brute - 5e-9  # a local minimum, never below the global one
+    res = cs.search(r, A, [10.0], warm=False)
+    assert 0.5 * (res.k_wheel_lateral + res.k_rail_lateral)[0, 0] > 0.0
+    assert -1e-12 <= g_brute - res.gap[0, 0] <= 5e-9

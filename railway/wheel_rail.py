@@ -863,16 +863,18 @@ def _check_derailment(st, res, out, last_YQ):
             f"wheel {labels[i]!r}: {last(i)}")
 
 
-def contact_history(model, result, element=None, wheels=None):
+def contact_history(model, result, element=None, wheels=None, max_step=2e-3):
     """Per output time and wheel, what a railway engineer reads (long format).
 
     The outputs of :meth:`WheelRailKind.contact_outputs` are evaluated at the stored states of
-    ``result`` with a fresh search state at every row (the global cross-section scan and the
-    robust refinement of :meth:`WheelRailKind.reset_state`), so that every row depends on its
-    (t, q, v) alone.  (Replaying the tracked state along the output times instead would track
-    the contacts over the output interval -- 50 ms, a metre of track at 20 m/s -- and lose a
-    patch where a tracked point runs onto a saddle of the gap; the run itself re-seeds after
-    every accepted step.)
+    ``result``, with the search state tracked along the run as the integrator tracks it: reset at
+    the first row, then carried from row to row through the accept hook at intermediate states
+    at most ``max_step`` apart (positions and velocities interpolated linearly between the stored
+    rows, Euler parameters normalised; these states only move the seeds, every row is evaluated
+    at its stored state).  A run re-seeds after every accepted step (~1 ms); replaying the
+    tracked state only at the output times (50 ms, a metre of track at 20 m/s, apart) would lose
+    patches that the run had, and a fresh global search at every row would pick the patches
+    afresh where two of them share a zone -- either would misstate the forces the run applied.
 
     Returns
     -------
@@ -894,7 +896,17 @@ def contact_history(model, result, element=None, wheels=None):
     try:
         for i, t in enumerate(result.t):
             bs = model.body_states(result.q[i], result.v[i])
-            kind.reset_state(bs, float(t))
+            if i == 0:
+                kind.reset_state(bs, float(t))
+            else:
+                t_prev = float(result.t[i - 1])
+                n_sub = int(np.ceil((float(t) - t_prev) / max_step))
+                for k in range(1, n_sub):
+                    w = k / n_sub
+                    qk = model.normalize((1.0 - w) * np.asarray(result.q[i - 1]) + w * np.asarray(result.q[i]))
+                    vk = (1.0 - w) * np.asarray(result.v[i - 1]) + w * np.asarray(result.v[i])
+                    kind.accept_step(model.body_states(qk, vk), t_prev + w * (float(t) - t_prev), reseed=True)
+                kind.accept_step(bs, float(t), reseed=True)
             out = kind.contact_outputs(bs, float(t), st.name)
             r, A, v, w = st.states(bs)
             speed = np.einsum("nk,nk->n", v, st.track.evaluate_raw(np.nan_to_num(out["wheelsets"]["s [m]"]))[3][:, :, 0])

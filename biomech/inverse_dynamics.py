@@ -120,7 +120,8 @@ def inverse_dynamics(trial: GaitTrial) -> pd.DataFrame:
     DataFrame
         ``time [s]`` and ``<coordinate>_moment [N m]`` / ``<coordinate>_force [N]``;
         ``attrs``: ``max_residual`` (of Φ_qᵀλ = Q − M a, zero for a driven mechanism),
-        ``kinematic_status``, wall times, the settings.
+        ``kinematic_status``, wall times, the settings, ``joint_reactions`` (a DataFrame of the
+        joint reaction forces, :meth:`biomech.sagittal.SagittalModel.joint_reactions`).
     """
     from core.analysis import inverse_dynamics as core_id
     from core.analysis import kinematic_analysis
@@ -143,11 +144,13 @@ def inverse_dynamics(trial: GaitTrial) -> pd.DataFrame:
     res = core_id(m, times, q, v, a, drivers=[])
     lam = res[[c for c in res.columns if c.startswith("lambda[")]].to_numpy()
     out = sm.generalized_forces(times, q, lam)
+    reactions = sm.joint_reactions(times, q, lam)
     t3 = time.perf_counter()
     out.attrs.update(max_residual=float(res.attrs["max_residual"]), kinematic_status=kin.attrs["status"],
                      wall_time_build=t1 - t0, wall_time_kinematics=t2 - t1, wall_time_inverse_dynamics=t3 - t2,
                      n_frames=len(times), body_mass=trial.body_mass, **trial.settings)
     out.attrs["cartesian"] = dict(q=q, v=v, a=a, lam=lam)
+    out.attrs["joint_reactions"] = reactions
     return out
 
 

@@ -384,6 +384,25 @@ class SagittalModel:
             cols[f"{c}_{kind} [{unit}]"] = vals[c]
         return pd.DataFrame(cols)
 
+    def joint_reactions(self, t, q, lam) -> pd.DataFrame:
+        """Joint reaction forces per frame: the force the parent exerts on the child at the joint
+        (the origin of the child's joint frame M), in ground axes.
+
+        The constraint force on the child body is −Φ_qᵀλ over its block; the position rows have
+        the identity there, so the force is −λ_pos, applied at the joint point (the angle row's
+        multiplier is the moment, reported by :meth:`generalized_forces`).  Columns
+        ``<joint>_on_<child>_Fx [N]``, ``_Fy [N]`` (OpenSim's JointReaction analysis reports the same
+        force, child side, when expressed in ground).
+        """
+        groups = self.model.reaction_groups()
+        cols = {"time [s]": np.asarray(t, float)}
+        for uc in self.joints:
+            rows = groups[uc.name]
+            F = -np.asarray(lam)[:, rows[:2]]
+            cols[f"{uc.name}_on_{uc.jt.child}_Fx [N]"] = F[:, 0]
+            cols[f"{uc.name}_on_{uc.jt.child}_Fy [N]"] = F[:, 1]
+        return pd.DataFrame(cols)
+
 
 def build_sagittal_model(osim, kinematics, loads=None, name=None):
     """The core model of a sagittal OpenSim model with its coordinates driven by ``kinematics``.

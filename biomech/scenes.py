@@ -141,7 +141,8 @@ def _run_inverse_dynamics(ctx):
     return SceneResult(tables={"joint_moments_summary": table, "pelvis_residuals": pd.DataFrame(res_rows),
                                "anthropometric_model_vs_gait10dof": small_cmp,
                                "timing": pd.DataFrame([timing]),
-                               "joint_moments": ours},
+                               "joint_moments": ours,
+                               "joint_reactions": ours.attrs["joint_reactions"]},
                        figures={"joint_moments": fig}, notes=notes)
 
 

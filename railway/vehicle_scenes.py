@@ -557,13 +557,13 @@ def _run_curving(ctx):
             for s_ in (c["lead"], c["lead"] + c["transition"], c["lead"] + c["transition"] + c["curve_length"]):
                 a.axvline(s_, ls=":", c="k", lw=0.7)
             a.grid(True, alpha=0.3)
-        ax[0, 0].set(ylabel="flange force, leading outer wheel [kN]",
+        ax[0, 0].set(ylabel="flange force [kN]\n(leading outer wheel)",
                      title=f"railway-curving — Manchester coach, R = {c['radius']:g} m, cant {c['cant'] * 1e3:g} mm, "
                            f"V = {V:g} m/s, {METHOD} rtol {RTOL:g}\nleading wheelset (dotted: transition, full curve)")
         ax[0, 0].title.set_fontsize(9)
         ax[0, 0].legend(fontsize=7)
         ax[1, 0].set(xlabel="track arc length of the leading wheelset [m]",
-                     ylabel="lateral displacement, leading wheelset [mm]")
+                     ylabel="lateral displacement [mm]\n(leading wheelset)")
         figs[f"leading_wheelset_{int(V)}ms"] = fig
         # Q of the leading wheels: lift-off
         fig, ax = _fig(size=(8, 3.6))
@@ -725,11 +725,8 @@ def _run_irregular(ctx):
         f"core.sweep.run_sweep (serial by default; `mbsuite run ... --workers N` or `--dask ADDRESS` "
         f"give the same table: tests/railway/test_vehicle_scenes.py). Car-body accelerations from the "
         f"centre-of-mass velocities (200 Hz output) after a 2 s start transient; wheel forces at 20 Hz. "
-        f"Caution on the wheel forces: the peaks of Q (several times the static load) come from "
-        f"near-conformal S1002 tread points that the single-ellipse Hertz model turns into very wide, "
-        f"very stiff patches when the contact jumps across the tread (e.g. replaying the 20 m/s run at 1 kHz, "
-        f"t = 5.861 s: 351 kN on a 45 um penetration with a lateral semi-axis of 185 mm); they are a limitation of "
-        f"the contact model, not wheel loads to quote (README, Railway vehicles).")
+        f"The wheel forces are those the run applied: railway.wheel_rail.contact_history replays the "
+        f"contact search state along the run in steps of at most 2 ms.")
     return dict(tables={"irregular_track": _units(table)}, figures={"carbody_acceleration_spectra": fig}, notes=notes)
 
 

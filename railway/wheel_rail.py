@@ -591,9 +591,10 @@ class WheelRailKind(ForceKind):
         for st in self.sets:
             st.state = self._fresh_state(st, bs)
 
-    def accept_step(self, bs, t, reseed=False):
+    def accept_step(self, bs, t, reseed=False, check=True):
         """Search-state update after an accepted step (module docstring); ``reseed=True`` scans
-        whatever ``reseed_every`` says (the replay of :func:`contact_history`)."""
+        whatever ``reseed_every`` says and ``check=False`` skips the derailment checks (the replay
+        of :func:`contact_history`, which also replays the last state of a derailed run)."""
         for st in self.sets:
             state = st.state
             if state is None:
@@ -613,7 +614,8 @@ class WheelRailKind(ForceKind):
                 res, X, G, prob = st.accept_pairs(r, Ans, s, True, robust=state.valid)
             f = st.forces(res, r, Ans, v, w)
             out = _wheel_quantities(st, res, f, r, Ans, s, w)
-            _check_derailment(st, res, out, state.last_YQ)
+            if check:
+                _check_derailment(st, res, out, state.last_YQ)
             xb = np.column_stack([res.theta.ravel(), res.y_wheel.ravel(), res.s_rail.ravel(), res.u_rail.ravel()])
             st.state = _State(seeds=_two_lowest_pairs(xb, res.valid.ravel(), X, G, prob, state.seeds),
                               s_ws=s, valid=res.valid.ravel().copy(), accepted=state.accepted + 1,
@@ -905,8 +907,9 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3):
                     w = k / n_sub
                     qk = model.normalize((1.0 - w) * np.asarray(result.q[i - 1]) + w * np.asarray(result.q[i]))
                     vk = (1.0 - w) * np.asarray(result.v[i - 1]) + w * np.asarray(result.v[i])
-                    kind.accept_step(model.body_states(qk, vk), t_prev + w * (float(t) - t_prev), reseed=True)
-                kind.accept_step(bs, float(t), reseed=True)
+                    kind.accept_step(model.body_states(qk, vk), t_prev + w * (float(t) - t_prev), reseed=True,
+                                     check=False)
+                kind.accept_step(bs, float(t), reseed=True, check=False)
             out = kind.contact_outputs(bs, float(t), st.name)
             r, A, v, w = st.states(bs)
             speed = np.einsum("nk,nk->n", v, st.track.evaluate_raw(np.nan_to_num(out["wheelsets"]["s [m]"]))[3][:, :, 0])

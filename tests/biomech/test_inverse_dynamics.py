@@ -108,3 +108,22 @@ def test_window_outside_the_force_data_names_the_files():
     with pytest.raises(DataRangeError, match="subject01_walk_IK.mot"):
         load_trial(DATA / "subject01.osim", DATA / "subject01_walk_IK.mot", DATA / "subject01_walk_grf.xml",
                    window=(0.5, 3.0))
+
+
+def test_joint_reactions_balance_the_foot(trial, moments):
+    """Newton's law for the right foot (talus, calcaneus, toes welded): the ankle reaction on the
+    talus plus the ground reaction plus gravity equals the feet's mass times their centre-of-mass
+    acceleration (accelerations from core's kinematic analysis, an independent use of them)."""
+    R = moments.attrs["joint_reactions"]
+    cart = moments.attrs["cartesian"]
+    sm_bodies = [b.name for b in trial.osim.bodies]
+    g = np.asarray(trial.osim.gravity, float)[:2]
+    grf = next(f for f in trial.loads.forces if f.spec.applied_to_body == "calcn_r")
+    for k in (0, 6, 12):
+        ma = np.zeros(2)
+        for name in ("talus_r", "calcn_r", "toes_r"):
+            b = sm_bodies.index(name)
+            body = trial.osim.bodies[b]
+            ma += body.mass * (cart["a"][k][3 * b:3 * b + 2] - g)
+        F = np.array([R["ankle_r_on_talus_r_Fx [N]"].iloc[k], R["ankle_r_on_talus_r_Fy [N]"].iloc[k]])
+        np.testing.assert_allclose(F + grf.force[k, :2], ma, atol=1e-6 * np.abs(ma).max() + 1e-8)

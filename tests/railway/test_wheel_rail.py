@@ -17,7 +17,7 @@ from railway.contact_geometry import rigid_contact
 from railway.creep import kalker_coefficients
 from railway.track import Track
 from railway.vehicle import GRAVITY, VehicleDefinition, build_vehicle
-from railway.wheel_rail import WheelRailContact
+from railway.wheel_rail import WheelRailContact, contact_history
 
 V = 20.0
 R0 = 0.46
@@ -187,6 +187,9 @@ def test_a_flange_that_has_climbed_ends_the_run_naming_the_wheel(method):
     res = simulate(m, (0.0, 0.05), method, rtol=1e-4, atol=1e-6)
     assert res.status == "failed"
     assert "flange climb" in res.message and "'ws right'" in res.message and "Y/Q" in res.message
+    # the run's rows up to the failure replay into a contact history (no check raises in the replay)
+    H = contact_history(m, res)
+    assert len(H) == 2 * len(res.t) and np.isfinite(H["Q [N]"]).all()
     ok = simulate(wheelset_model(y0=-0.005, creep_law="polach2000"), (0.0, 0.05), method, rtol=1e-4, atol=1e-6)
     assert ok.success, ok.message
 

@@ -1,0 +1,832 @@
+"""Roller-coaster track centrelines g(L) in arc length L, with g', g'', g''', g''''.
+
+A centreline is a space curve parameterised by its arc length L (m); every centreline here
+returns the point and its first four derivatives in L at once (:meth:`Centreline.derivatives`)::
+
+    g(L),  g' = t (unit tangent),  g'' = kappa n,  g''',  g''''
+
+from which the frames of :mod:`coaster.frames` take the curvature, torsion and Darboux vector
+(Frenet: g' ... g''''; rotation-minimising: g' ... g'''' for the table of omega'').
+
+Two kinds of centreline are provided:
+
+* **Splines through control points** (:class:`SplineCentreline`): cubic C2 (natural, not-a-knot
+  or periodic), quintic C4 (not-a-knot or periodic), and shape-preserving C1 (PCHIP or Akima),
+  open or closed, fitted in the chord-length parameter u and reparameterised by arc length
+  (Gauss-Legendre quadrature of |g_u| per span, Newton inversion u(L); formulas in the class).
+* **Analytic segments** with exact derivatives: :class:`Straight`, :class:`CircularArc`,
+  :class:`Helix`, :class:`Clothoid`, :class:`VerticalLoop`, joined into a
+  :class:`CompositeCentreline` (use :func:`chain` to place them end to end).
+
+:func:`read_circuit` reads the shared closed circuit (``data/coaster``), converting Unreal
+Engine's left-handed centimetre axes to right-handed metres.
+
+References
+----------
+Pombo, J. and Ambrosio, J. (2007). Modelling tracks for roller coaster dynamics. Int. J. Vehicle
+Design 45(4):470-500 (cubic, Akima and shape-preserving splines for coaster tracks; arc-length
+parameterisation).  Equation numbers were not checked against the paper here.
+Fritsch, F. N. and Carlson, R. E. (1980). Monotone piecewise cubic interpolation. SIAM J. Numer.
+Anal. 17(2):238-246 (PCHIP).  Akima, H. (1970). J. ACM 17(4):589-602 (Akima spline).
+"""
+
+from __future__ import annotations
+
+import abc
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import scipy.interpolate as si
+import scipy.special as sp
+
+from core.errors import DataFileError, InputError, NumericalFailure
+
+__all__ = [
+    "Centreline",
+    "CircuitData",
+    "CircularArc",
+    "Clothoid",
+    "CompositeCentreline",
+    "Helix",
+    "Segment",
+    "SplineCentreline",
+    "Straight",
+    "VerticalLoop",
+    "chain",
+    "circuit_centreline",
+    "read_circuit",
+    "CIRCUIT_FILE",
+]
+
+DATA_DIR = Path(__file__).resolve().parent.parent / "data" / "coaster"
+#: The shared closed circuit (203 control points, centimetres, left-handed; see its README).
+CIRCUIT_FILE = DATA_DIR / "yarlung_track_coaster-sim_MIT.csv"
+
+
+# ---------------------------------------------------------------------------------------------
+# interface
+# ---------------------------------------------------------------------------------------------
+class Centreline(abc.ABC):
+    """A track centreline g(L) in arc length L with its first four derivatives.
+
+    Attributes
+    ----------
+    length : float
+        Arc length (m); L runs over [0, length].
+    closed : bool
+        The curve closes on itself (L is taken modulo ``length``).
+    breaks : (m,) ndarray
+        Arc lengths (m) where a derivative of g may jump (knots, segment joints), including 0
+        and ``length``.  Tables built on the curve put nodes there and use one-sided values.
+    name : str
+        Label in error messages.
+    """
+
+    length: float
+    closed: bool = False
+    breaks: np.ndarray
+    name: str = "centreline"
+
+    def derivatives(self, L, side: str = "right"):
+        """g and its first four derivatives in L at the arc lengths ``L``.
+
+        Parameters
+        ----------
+        L : float or array_like
+            Arc lengths (m), flattened.  A closed curve takes L modulo ``length``; an open one
+            extrapolates its end pieces.
+        side : {"right", "left"}
+            At a break, use the piece to the right (L+) or to the left (L-).
+
+        Returns
+        -------
+        (5, N, 3) ndarray
+            g (m), g' (-), g'' (1/m), g''' (1/m^2), g'''' (1/m^3).
+
+        Raises
+        ------
+        InputError
+            A non-finite arc length (named with its index) or a bad ``side``.
+        """
+        L = np.atleast_1d(np.asarray(L, dtype=float)).reshape(-1)
+        bad = ~np.isfinite(L)
+        if np.any(bad):
+            i = int(np.argmax(bad))
+            raise InputError(f"{self.name}: non-finite arc length L[{i}] = {float(L[i])!r}")
+        if side not in ("right", "left"):
+            raise InputError(f"{self.name}: side must be 'right' or 'left', got {side!r}")
+        if self.closed:
+            Lw = np.mod(L, self.length)
+            if side == "left":  # L = 0 from the left is the end of the last piece
+                Lw = np.where(Lw == 0.0, self.length, Lw)
+            L = Lw
+        return self._derivatives(L, side)
+
+    @abc.abstractmethod
+    def _derivatives(self, L, side):
+        """:meth:`derivatives` after validation (L finite, 1-D, wrapped if closed)."""
+
+    def curvature_torsion(self, L):
+        """Curvature kappa = |g''| (1/m) and torsion tau = g'.(g'' x g''')/kappa^2 (1/m).
+
+        tau is NaN where kappa = 0 (undefined there).
+        """
+        d = self.derivatives(L)
+        k = np.linalg.norm(d[2], axis=1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tau = np.einsum("ij,ij->i", d[1], np.cross(d[2], d[3])) / k**2
+        return k, tau
+
+
+# ---------------------------------------------------------------------------------------------
+# splines through control points
+# ---------------------------------------------------------------------------------------------
+_SPLINE_KINDS = ("cubic", "quintic", "pchip", "akima", "makima")
+
+
+class SplineCentreline(Centreline):
+    """Interpolating spline through control points, reparameterised by arc length.
+
+    **Fit.**  The points P_j (m) get chord-length parameters u_0 = 0, u_j = u_{j-1} + |P_j -
+    P_{j-1}| (a closed curve adds the closing chord), and each coordinate is interpolated in u
+    with scipy (its interpolators are well-tested, return a ``PPoly`` whose local polynomials we
+    evaluate directly, and cover every kind below, so nothing is re-implemented):
+
+    =========== ============================= ========== ================================
+    kind        scipy                          continuity boundary (open / closed)
+    =========== ============================= ========== ================================
+    ``cubic``   ``CubicSpline``                C2         ``bc`` natural or not-a-knot / periodic
+    ``quintic`` ``make_interp_spline(k=5)``    C4         not-a-knot / periodic
+    ``pchip``   ``PchipInterpolator``          C1         one-sided 3-point / wrapped neighbours
+    ``akima``   ``Akima1DInterpolator``        C1         Akima's ends / wrapped neighbours
+    ``makima``  ``Akima1DInterpolator(makima)`` C1        as akima
+    =========== ============================= ========== ================================
+
+    Shape-preserving kinds act per coordinate: where all three coordinates have a local extremum
+    at the same control point the curve has zero speed there (a cusp), which is refused.
+    A closed shape-preserving curve is fitted to the points padded by three wrapped neighbours
+    at each end; PCHIP and Akima slopes depend on at most two neighbours, so the derivative at
+    the seam equals the periodic one.  Continuity matters for the forces (notes/coaster.md):
+    C1 splines make the curvature jump at every knot, a cubic makes g''' (torsion) jump, a
+    quintic is C4.
+
+    **Arc length.**  With the speed s(u) = |g_u| (s_u, s_uu, s_uuu its u-derivatives)::
+
+        L(u) = L_i + int_{u_i}^{u} s(v) dv          (Gauss-Legendre, n_gauss points per span)
+        u <- u - (L(u) - L*) / s(u)                  (Newton inversion, from the chord guess)
+        u' = 1/s,  u'' = -s_u/s^3,  u''' = u'(-s_uu/s^3 + 3 s_u^2/s^4),
+        u'''' = -s_uuu/s^5 + 10 s_u s_uu/s^6 - 15 s_u^3/s^7
+        s_u = g_u.g_uu/s,  s_uu = (g_uu.g_uu + g_u.g_uuu - s_u^2)/s,
+        s_uuu = (3 g_uu.g_uuu + g_u.g_uuuu - 3 s_u s_uu)/s
+        g_L = g_u u',  g_LL = g_uu u'^2 + g_u u'',
+        g_LLL = g_uuu u'^3 + 3 g_uu u' u'' + g_u u''',
+        g_LLLL = g_uuuu u'^4 + 6 g_uuu u'^2 u'' + g_uu (3 u''^2 + 4 u' u''') + g_u u''''
+
+    (Faa di Bruno for the inverse function; notes/coaster.md "Frames").  The quadrature error
+    of a panel is of order (Delta u)^(2 n_gauss) |s^(2 n_gauss)|; every span is split into
+    ``n_sub`` equal panels, doubled (up to 256) until the total length changes by less than
+    1e-13 relative (the last change is kept in ``quadrature_change``).
+
+    Parameters
+    ----------
+    points : (N, 3) array_like
+        Control points (m), N >= 4; a closed curve must not repeat its first point at the end
+        (an exact repetition is dropped).
+    kind : {"cubic", "quintic", "pchip", "akima", "makima"}
+    closed : bool
+    bc : {"not-a-knot", "natural"}
+        End condition of an open cubic (ignored otherwise).
+    n_gauss : int
+        Gauss-Legendre points per span for the arc length.
+    name : str
+
+    Attributes
+    ----------
+    u_knots : (n+1,) ndarray
+        Parameter breakpoints of the spline pieces.
+    L_knots : (n+1,) ndarray
+        Arc length at those breakpoints (m); ``breaks``.
+    L_points : (N,) ndarray
+        Arc length at the control points (m).
+    length : float
+
+    Raises
+    ------
+    InputError
+        Fewer than 4 points, a non-finite coordinate, or two consecutive equal points (the
+        message names the index), an unknown kind or end condition.
+
+    References
+    ----------
+    Pombo, J. and Ambrosio, J. (2007). Int. J. Vehicle Design 45(4):470-500 (splines for
+    coaster tracks, arc-length parameterisation).
+    """
+
+    def __init__(self, points, kind="cubic", closed=False, bc="not-a-knot", n_gauss=8,
+                 name="spline centreline"):
+        self.name = str(name)
+        if kind not in _SPLINE_KINDS:
+            raise InputError(f"{self.name}: unknown spline kind {kind!r}; use one of {_SPLINE_KINDS}")
+        if bc not in ("not-a-knot", "natural"):
+            raise InputError(f"{self.name}: unknown end condition bc={bc!r}; use 'not-a-knot' or 'natural'")
+        P = np.asarray(points, dtype=float)
+        if P.ndim != 2 or P.shape[1] != 3:
+            raise InputError(f"{self.name}: points must have shape (N, 3), got {P.shape}")
+        bad = ~np.isfinite(P)
+        if np.any(bad):
+            i, j = np.unravel_index(int(np.argmax(bad)), P.shape)
+            raise InputError(f"{self.name}: point {i} coordinate {j} = {float(P[i, j])!r} is not finite")
+        if closed and P.shape[0] > 1 and np.array_equal(P[0], P[-1]):
+            P = P[:-1]
+        if P.shape[0] < 4:
+            raise InputError(f"{self.name}: need at least 4 control points, got {P.shape[0]}")
+        chords = np.linalg.norm(np.diff(np.vstack([P, P[:1]]) if closed else P, axis=0), axis=1)
+        scale = float(np.max(np.abs(P - P.mean(axis=0)))) or 1.0
+        tiny = chords <= 1e-12 * scale
+        if np.any(tiny):
+            i = int(np.argmax(tiny))
+            j = (i + 1) % P.shape[0]
+            raise InputError(f"{self.name}: control points {i} and {j} coincide ({P[i].tolist()}); "
+                             f"consecutive points must differ")
+        self.points = P
+        self.kind = kind
+        self.closed = bool(closed)
+        self.bc = bc
+        self.n_gauss = int(n_gauss)
+        u = np.concatenate([[0.0], np.cumsum(chords)])  # closed: N+1 values, last = first point
+        Y = np.vstack([P, P[:1]]) if closed else P
+        if not closed:
+            u = u[: P.shape[0]]
+        self._fit(u, Y)
+        self._arc_length()
+        self.L_points = self._L_of_u(u[: P.shape[0]])
+        self.breaks = self.L_knots
+
+    # --- fit -----------------------------------------------------------------------------
+    def _fit(self, u, Y):
+        kind, closed = self.kind, self.closed
+        if kind == "cubic":
+            pp = si.CubicSpline(u, Y, axis=0, bc_type="periodic" if closed else self.bc)
+            x, c = pp.x, pp.c  # (4, n, 3) descending
+        elif kind == "quintic":
+            b = si.make_interp_spline(u, Y, k=5, axis=0, bc_type="periodic" if closed else None)
+            pps = [si.PPoly.from_spline(si.BSpline(b.t, b.c[:, j], 5)) for j in range(3)]
+            x, c = pps[0].x, np.stack([p.c for p in pps], axis=-1)
+        else:
+            if closed:
+                U, n = u[-1], u.size - 1
+                pad = 3
+                uu = np.concatenate([u[n - pad:n] - U, u, u[1:pad + 1] + U])
+                YY = np.vstack([Y[n - pad:n], Y, Y[1:pad + 1]])
+            else:
+                uu, YY = u, Y
+            if kind == "pchip":
+                pp = si.PchipInterpolator(uu, YY, axis=0)
+            else:
+                pp = si.Akima1DInterpolator(uu, YY, axis=0, method=kind)
+            x, c = pp.x, pp.c
+        keep = (x[:-1] >= u[0] - 1e-12 * u[-1]) & (x[1:] <= u[-1] * (1 + 1e-12)) & (np.diff(x) > 0)
+        idx = np.flatnonzero(keep)
+        self.u_knots = np.concatenate([x[idx], x[idx[-1] + 1:idx[-1] + 2]])
+        c = c[:, idx, :]
+        k = c.shape[0] - 1
+        self._coef = np.ascontiguousarray(c[::-1].transpose(1, 0, 2))  # (n, k+1, 3) ascending
+        self.degree = k
+        n = self._coef.shape[0]
+        sp = self._speed(np.arange(n), np.zeros(n))
+        small = sp <= 1e-9 * max(1.0, float(np.max(sp)))
+        if np.any(small):
+            j = int(np.argmax(small))
+            raise InputError(f"{self.name}: the {kind} spline has zero speed |dg/du| at u = "
+                             f"{float(self.u_knots[j])!r} (knot {j}): a cusp, where every coordinate "
+                             f"has a local extremum (PCHIP/Akima set such slopes to zero); add or move "
+                             f"control points or use a cubic/quintic spline")
+
+    def _poly(self, i, du, nder):
+        """g_u derivatives 0..nder of pieces i at local offsets du: (nder+1, N, 3)."""
+        c = self._coef[i]  # (N, k+1, 3)
+        k = self.degree
+        out = np.zeros((nder + 1,) + du.shape + (3,))
+        for d in range(nder + 1):
+            if d > k:
+                break
+            j = np.arange(d, k + 1)
+            fac = np.array([math.perm(int(jj), d) for jj in j], dtype=float)
+            powr = du[:, None] ** (j - d)  # (N, k+1-d)
+            out[d] = np.einsum("nj,njc->nc", powr * fac, c[:, j, :])
+        return out
+
+    def _speed(self, i, du):
+        g1 = self._poly(i, du, 1)[1]
+        return np.linalg.norm(g1, axis=-1)
+
+    def _arc_length(self):
+        xg, wg = np.polynomial.legendre.leggauss(self.n_gauss)
+        self._xg, self._wg = xg, wg
+        h = np.diff(self.u_knots)
+        i = np.arange(h.size)
+        self.n_sub = 1
+        dL = self._partial_L(i, h)
+        while True:
+            self.n_sub *= 2
+            dL2 = self._partial_L(i, h)
+            change = float(np.max(np.abs(dL2 - dL)))
+            if change <= 1e-13 * float(np.sum(dL2)) or self.n_sub >= 256:
+                break
+            dL = dL2
+        self.quadrature_change = change
+        self.L_knots = np.concatenate([[0.0], np.cumsum(dL2)])
+        self.length = float(self.L_knots[-1])
+
+    def _partial_L(self, i, du):
+        """int_0^du s(u_i + v) dv by composite Gauss-Legendre (n_sub panels) on [0, du]."""
+        ng, m = self.n_gauss, self.n_sub
+        x = ((np.arange(m)[:, None] + 0.5 * (self._xg[None, :] + 1.0)) / m).reshape(-1)  # (m*ng,)
+        w = np.tile(self._wg, m) / m
+        v = x[None, :] * du[:, None]
+        s = self._speed(np.repeat(i, m * ng), v.reshape(-1)).reshape(-1, m * ng)
+        return 0.5 * du * (s @ w)
+
+    def _L_of_u(self, u):
+        i = np.clip(np.searchsorted(self.u_knots, u, side="right") - 1, 0, self.u_knots.size - 2)
+        return self.L_knots[i] + self._partial_L(i, u - self.u_knots[i])
+
+    def u_of_L(self, L, side="right", tol=1e-13, max_iter=30):
+        """Spline parameter u and piece index at arc lengths L (Newton inversion, class docstring).
+
+        Returns
+        -------
+        i : (N,) int ndarray
+            Piece index.
+        du : (N,) ndarray
+            Offset u - u_i in the piece.
+
+        Raises
+        ------
+        NumericalFailure
+            Newton does not converge (names the arc length).
+        """
+        nk = self.L_knots.size
+        i = np.searchsorted(self.L_knots, L, side=side) - 1
+        i = np.clip(i, 0, nk - 2)
+        h = np.diff(self.u_knots)[i]
+        dL = np.diff(self.L_knots)[i]
+        target = L - self.L_knots[i]
+        du = target / dL * h
+        for _ in range(max_iter):
+            F = self._partial_L(i, du) - target
+            s = self._speed(i, du)
+            step = F / s
+            du = du - step
+            if np.all(np.abs(step) <= tol * max(1.0, float(self.u_knots[-1]))):
+                return i, du
+        j = int(np.argmax(np.abs(step)))
+        raise NumericalFailure(f"{self.name}: arc-length inversion did not converge at L = {float(L[j])!r} m "
+                               f"(last step {float(step[j])!r})")
+
+    def _derivatives(self, L, side):
+        i, du = self.u_of_L(L, side)
+        G = self._poly(i, du, 4)
+        g0, g1, g2, g3, g4 = G
+        dot = lambda a, b: np.einsum("ij,ij->i", a, b)  # noqa: E731
+        s = np.linalg.norm(g1, axis=1)
+        s1 = dot(g1, g2) / s
+        s2 = (dot(g2, g2) + dot(g1, g3) - s1**2) / s
+        s3 = (3.0 * dot(g2, g3) + dot(g1, g4) - 3.0 * s1 * s2) / s
+        u1 = 1.0 / s
+        u2 = -s1 / s**3
+        u3 = u1 * (-s2 / s**3 + 3.0 * s1**2 / s**4)
+        u4 = -s3 / s**5 + 10.0 * s1 * s2 / s**6 - 15.0 * s1**3 / s**7
+        c = lambda a: a[:, None]  # noqa: E731
+        gL = g1 * c(u1)
+        gLL = g2 * c(u1**2) + g1 * c(u2)
+        gLLL = g3 * c(u1**3) + 3.0 * g2 * c(u1 * u2) + g1 * c(u3)
+        gLLLL = (g4 * c(u1**4) + 6.0 * g3 * c(u1**2 * u2) + g2 * c(3.0 * u2**2 + 4.0 * u1 * u3)
+                 + g1 * c(u4))
+        return np.stack([g0, gL, gLL, gLLL, gLLLL])
+
+
+# ---------------------------------------------------------------------------------------------
+# analytic segments
+# ---------------------------------------------------------------------------------------------
+def _rot_z(psi):
+    c, s = math.cos(psi), math.sin(psi)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+class Segment(Centreline):
+    """An analytic segment: a local closed form g_loc(L) placed by a rigid motion.
+
+        g(L) = origin + Q g_loc(L),   g^(k)(L) = Q g_loc^(k)(L)
+
+    with g_loc(0) = 0.  Subclasses implement ``_local(L)`` returning (5, N, 3).
+
+    Parameters
+    ----------
+    origin : (3,) array_like, optional
+        Start point (m); default 0.
+    rotation : (3, 3) array_like, optional
+        Proper rotation Q (local to global); default identity.
+    """
+
+    closed = False
+
+    def __init__(self, origin=None, rotation=None, name=None):
+        self.name = name or type(self).__name__
+        self.origin = np.zeros(3) if origin is None else np.asarray(origin, dtype=float).reshape(3)
+        Q = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
+        if Q.shape != (3, 3) or not np.allclose(Q.T @ Q, np.eye(3), atol=1e-10) or np.linalg.det(Q) < 0:
+            raise InputError(f"{self.name}: rotation must be a proper 3x3 rotation matrix")
+        if not np.all(np.isfinite(self.origin)):
+            raise InputError(f"{self.name}: origin {self.origin.tolist()} is not finite")
+        self.rotation = Q
+        self.breaks = np.array([0.0, self.length])
+
+    def placed(self, origin, rotation):
+        """A copy of the segment at another origin and rotation."""
+        import copy
+
+        new = copy.copy(self)
+        Segment.__init__(new, origin, rotation, self.name)
+        return new
+
+    def _derivatives(self, L, side):
+        d = self._local(L)
+        out = d @ self.rotation.T
+        out[0] += self.origin
+        return out
+
+    @abc.abstractmethod
+    def _local(self, L):
+        """(5, N, 3) local g_loc and derivatives."""
+
+    @staticmethod
+    def _positive(name, label, value):
+        value = float(value)
+        if not np.isfinite(value) or value <= 0.0:
+            raise InputError(f"{name}: {label} must be positive and finite, got {value!r}")
+        return value
+
+
+class Straight(Segment):
+    """Straight line at grade angle gamma (rad, positive uphill) heading along local x.
+
+        g = L (cos gamma, 0, sin gamma),  g' = (cos gamma, 0, sin gamma),  g'' = g''' = g'''' = 0
+    """
+
+    def __init__(self, length, grade=0.0, origin=None, rotation=None, name=None):
+        self.length = self._positive(name or "Straight", "length", length)
+        self.grade = float(grade)
+        super().__init__(origin, rotation, name)
+
+    def _local(self, L):
+        e = np.array([math.cos(self.grade), 0.0, math.sin(self.grade)])
+        out = np.zeros((5, L.size, 3))
+        out[0] = L[:, None] * e
+        out[1] = e
+        return out
+
+
+def _helix_local(L, R, c, sign):
+    """Helix about local z through (0, sign R, 0): g = (R sin phi, sign R (1 - cos phi), c phi).
+
+    phi = L/h, h = sqrt(R^2 + c^2); d^k/dL^k = h^-k d^k/dphi^k with
+    (sin)^(k) = sin(phi + k pi/2), (1 - cos)^(k) = -cos(phi + k pi/2) for k >= 1.
+    """
+    h = math.hypot(R, c)
+    phi = L / h
+    out = np.zeros((5, L.size, 3))
+    out[0, :, 0] = R * np.sin(phi)
+    out[0, :, 1] = sign * R * (1.0 - np.cos(phi))
+    out[0, :, 2] = c * phi
+    for k in range(1, 5):
+        out[k, :, 0] = R * np.sin(phi + 0.5 * k * np.pi) / h**k
+        out[k, :, 1] = -sign * R * np.cos(phi + 0.5 * k * np.pi) / h**k
+    out[1, :, 2] = c / h
+    return out
+
+
+class Helix(Segment):
+    """Circular helix of radius R (m) and rise c (m per radian) about the local vertical.
+
+        g = (R sin phi, sigma R (1 - cos phi), c phi),  phi = L/h,  h = sqrt(R^2 + c^2)
+
+    (sigma = +1 turns left, -1 right); curvature kappa = R/h^2, torsion tau = sigma c/h^2,
+    Darboux vector sigma e_z/h (notes/coaster.md, closed forms).  The start tangent is
+    (R, 0, c)/h: on grade atan(c/R).
+
+    Parameters
+    ----------
+    radius : float
+        R (m).
+    rise : float
+        c (m per radian of turn); 2 pi c per turn.  0 gives a horizontal circular arc.
+    angle : float
+        Turned angle phi_end (rad), positive; length = h phi_end.
+    turn : {+1, -1}
+        sigma.
+    """
+
+    def __init__(self, radius, rise, angle, turn=1, origin=None, rotation=None, name=None):
+        nm = name or type(self).__name__
+        self.radius = self._positive(nm, "radius", radius)
+        self.rise = float(rise)
+        self.angle = self._positive(nm, "angle", angle)
+        if turn not in (1, -1):
+            raise InputError(f"{nm}: turn must be +1 (left) or -1 (right), got {turn!r}")
+        self.turn = int(turn)
+        self.h = math.hypot(self.radius, self.rise)
+        self.length = self.h * self.angle
+        super().__init__(origin, rotation, name)
+
+    def _local(self, L):
+        return _helix_local(L, self.radius, self.rise, self.turn)
+
+
+class CircularArc(Helix):
+    """Horizontal circular arc of radius R (m) through ``angle`` (rad); turn +1 left, -1 right.
+
+        g = (R sin(L/R), sigma R (1 - cos(L/R)), 0),  kappa = 1/R
+    """
+
+    def __init__(self, radius, angle, turn=1, origin=None, rotation=None, name=None):
+        super().__init__(radius, 0.0, angle, turn, origin, rotation, name)
+
+
+class VerticalLoop(Segment):
+    """Circular vertical loop of radius R (m), displaced sideways by ``offset`` (m) per loop.
+
+    A helix about the local lateral axis y (entering horizontally along x at the bottom)::
+
+        g = (R sin phi, sigma d phi, R (1 - cos phi)),  phi = L/h,  d = offset/(2 pi),
+        h = sqrt(R^2 + d^2),  length = 2 pi h
+
+    kappa = R/h^2; with offset 0 the exit coincides with the entry (a closed circle).
+    """
+
+    def __init__(self, radius, offset=0.0, origin=None, rotation=None, name=None):
+        nm = name or type(self).__name__
+        self.radius = self._positive(nm, "radius", radius)
+        self.offset = float(offset)
+        d = self.offset / (2.0 * math.pi)
+        self.h = math.hypot(self.radius, d)
+        self.length = 2.0 * math.pi * self.h
+        super().__init__(origin, rotation, name)
+
+    def _local(self, L):
+        d = self.offset / (2.0 * math.pi)
+        hel = _helix_local(L, self.radius, d, 1)  # (R sin, R(1-cos), d phi)
+        return hel[:, :, [0, 2, 1]]
+
+
+class Clothoid(Segment):
+    """Horizontal clothoid (Euler spiral): curvature linear in L from k_start to k_end (1/m).
+
+        kappa(L) = k0 + L/a,   a = length/(k_end - k_start)  (a = +-A^2, signed)
+        heading theta(L) = k0 L + L^2/(2a)
+        g' = (cos theta, sin theta, 0) = T,  N = (-sin theta, cos theta, 0),
+        g'' = kappa N,  g''' = N/a - kappa^2 T,  g'''' = -3 kappa T/a - kappa^3 N
+
+    The position is the standard clothoid c(s) = int_0^s (cos(v^2/2a), sin(v^2/2a)) dv,
+    c(s) = sqrt(pi |a|) (C(z), sgn(a) S(z)), z = s / sqrt(pi |a|) (Fresnel integrals),
+    taken from s0 = k0 a and turned so that the local start tangent is x:
+    g_loc(L) = Rz(-theta_0) (c(s0 + L) - c(s0)), theta_0 = s0^2/(2a).  Positive curvature
+    turns left.  Clothoids in a vertical plane (a clothoid loop) are placed with a rotation
+    about x (``rotation``).
+    """
+
+    def __init__(self, length, k_start, k_end, origin=None, rotation=None, name=None):
+        nm = name or type(self).__name__
+        self.length = self._positive(nm, "length", length)
+        self.k_start, self.k_end = float(k_start), float(k_end)
+        if not (np.isfinite(self.k_start) and np.isfinite(self.k_end)) or self.k_start == self.k_end:
+            raise InputError(f"{nm}: k_start ({self.k_start!r}) and k_end ({self.k_end!r}) must be finite "
+                             f"and differ (use CircularArc or Straight for constant curvature)")
+        self.a = self.length / (self.k_end - self.k_start)
+        super().__init__(origin, rotation, name)
+
+    def _std(self, s):
+        a = self.a
+        sc = math.sqrt(math.pi * abs(a))
+        S, C = sp.fresnel(s / sc)
+        return np.stack([sc * C, np.sign(a) * sc * S], axis=-1)
+
+    def _local(self, L):
+        a, k0 = self.a, self.k_start
+        s0 = k0 * a
+        th0 = s0**2 / (2 * a)
+        c0 = self._std(np.array([s0]))[0]
+        p = self._std(s0 + L) - c0
+        cth, sth = math.cos(th0), math.sin(th0)
+        out = np.zeros((5, L.size, 3))
+        out[0, :, 0] = cth * p[:, 0] + sth * p[:, 1]
+        out[0, :, 1] = -sth * p[:, 0] + cth * p[:, 1]
+        th = k0 * L + L**2 / (2 * a)
+        k = k0 + L / a
+        T = np.stack([np.cos(th), np.sin(th), 0 * th], axis=-1)
+        N = np.stack([-np.sin(th), np.cos(th), 0 * th], axis=-1)
+        out[1] = T
+        out[2] = k[:, None] * N
+        out[3] = N / a - (k**2)[:, None] * T
+        out[4] = -3.0 * (k / a)[:, None] * T - (k**3)[:, None] * N
+        return out
+
+
+class CompositeCentreline(Centreline):
+    """Segments joined end to end: g(L) = segment_k(L - L_k) on [L_k, L_{k+1}].
+
+    Parameters
+    ----------
+    segments : sequence of Centreline
+        Already placed (see :func:`chain`); each joint must be G1 (position within ``tol`` m,
+        unit tangents within ``tol``).
+    closed : bool
+        The last segment must end where the first starts (G1).
+    tol : float
+
+    Raises
+    ------
+    InputError
+        A joint (named by its index and the two segments) with a gap or a kink.
+    """
+
+    def __init__(self, segments, closed=False, tol=1e-8, name="composite centreline"):
+        self.name = str(name)
+        self.segments = list(segments)
+        if not self.segments:
+            raise InputError(f"{self.name}: no segments")
+        lengths = np.array([s.length for s in self.segments])
+        self.offsets = np.concatenate([[0.0], np.cumsum(lengths)])
+        self.length = float(self.offsets[-1])
+        self.closed = bool(closed)
+        pairs = list(zip(range(len(self.segments) - 1), range(1, len(self.segments))))
+        if closed:
+            pairs.append((len(self.segments) - 1, 0))
+        for a, b in pairs:
+            ea = self.segments[a].derivatives([self.segments[a].length], side="left")
+            sb = self.segments[b].derivatives([0.0])
+            gap = float(np.linalg.norm(ea[0, 0] - sb[0, 0]))
+            kink = float(np.linalg.norm(ea[1, 0] - sb[1, 0]))
+            if gap > tol or kink > tol:
+                raise InputError(f"{self.name}: joint {a}->{b} ({self.segments[a].name} -> "
+                                 f"{self.segments[b].name}) is not G1: gap {gap!r} m, tangent jump {kink!r}")
+        br = [self.offsets[k] + s.breaks for k, s in enumerate(self.segments)]
+        self.breaks = np.unique(np.concatenate(br))
+
+    def _derivatives(self, L, side):
+        k = np.clip(np.searchsorted(self.offsets, L, side=side) - 1, 0, len(self.segments) - 1)
+        out = np.empty((5, L.size, 3))
+        for j in np.unique(k):
+            m = k == j
+            out[:, m] = self.segments[j]._derivatives(L[m] - self.offsets[j], side)
+        return out
+
+
+def chain(segments, start=(0.0, 0.0, 0.0), heading=0.0):
+    """Place segments end to end by translating and turning each about the vertical.
+
+    Segment k is rotated about e_z (composed with its own ``rotation``) so that the horizontal
+    heading of its start tangent equals that of the previous end tangent, and translated to the
+    previous end point.  Grades must already match (e.g. a :class:`Straight` on grade
+    atan(c/R) before a :class:`Helix`); :class:`CompositeCentreline` reports a mismatch.
+
+    Parameters
+    ----------
+    segments : sequence of Segment
+    start : (3,) array_like
+        Start point of the first segment (m).
+    heading : float
+        Heading of the first segment's start tangent (rad from x towards y).
+
+    Returns
+    -------
+    list of Segment
+        Placed copies.
+    """
+    out = []
+    p = np.asarray(start, dtype=float)
+    psi_prev = float(heading)
+    for seg in segments:
+        d0 = seg._local(np.array([0.0]))[1, 0] @ seg.rotation.T
+        psi0 = math.atan2(d0[1], d0[0])
+        Q = _rot_z(psi_prev - psi0) @ seg.rotation
+        new = seg.placed(p, Q)
+        end = new.derivatives([new.length], side="left")
+        p = end[0, 0]
+        psi_prev = math.atan2(end[1, 0, 1], end[1, 0, 0])
+        out.append(new)
+    return out
+
+
+# ---------------------------------------------------------------------------------------------
+# the shared circuit
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class CircuitData:
+    """Control points of a coaster circuit in SI units and right-handed axes.
+
+    Attributes
+    ----------
+    points : (N, 3) ndarray
+        Control points (m): x forward, y left, z up.
+    roll : (N,) ndarray
+        Roll (bank) angle about the forward direction (rad), right-handed (positive rolls the
+        track's up vector towards -y, i.e. to the right when looking forward).
+    section : (N,) ndarray of str
+        Section names (Station, Lift, ...).
+    index : (N,) int ndarray
+        The file's ``idx`` column.
+    path : Path
+    """
+
+    points: np.ndarray
+    roll: np.ndarray
+    section: np.ndarray
+    index: np.ndarray
+    path: Path
+
+
+_COLUMNS = ["idx", "x", "y", "z", "roll_deg", "section", "terrain_z"]
+
+
+def read_circuit(path=None) -> CircuitData:
+    """Read a coaster-sim track CSV (Unreal Engine units) into SI, right-handed axes.
+
+    The file has columns ``idx,x,y,z,roll_deg,section,terrain_z`` in centimetres and degrees in
+    Unreal Engine's left-handed axes (X forward, Y right, Z up).  The conversion
+    (data/coaster/SOURCE.md) is::
+
+        (x, y, z)_SI = (x, -y, z) / 100 m,     roll_SI = -roll_deg * pi/180 rad
+
+    (mirroring y reverses the sense of every rotation).  ``terrain_z`` is ignored.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        Default :data:`CIRCUIT_FILE`.
+
+    Returns
+    -------
+    CircuitData
+
+    Raises
+    ------
+    DataFileError
+        Missing file, wrong header, a row with the wrong number of fields, a non-numeric or
+        non-finite value, or ``idx`` not counting 0, 1, 2, ... (the message names the file,
+        the data row and its line).
+    """
+    path = Path(CIRCUIT_FILE if path is None else path)
+    if not path.is_file():
+        raise DataFileError(f"{path}: circuit file not found")
+    pts, roll, sec, idx = [], [], [], []
+    with path.open(newline="") as fh:
+        rd = csv.reader(fh)
+        header = next(rd, None)
+        if header is None or [h.strip() for h in header] != _COLUMNS:
+            raise DataFileError(f"{path}: line 1: header must be {','.join(_COLUMNS)}, got {header!r}")
+        for row_no, row in enumerate(rd):
+            line = row_no + 2
+            if not row or all(not f.strip() for f in row):
+                continue
+            where = f"{path}: row {row_no} (line {line})"
+            if len(row) != len(_COLUMNS):
+                raise DataFileError(f"{where}: expected {len(_COLUMNS)} fields, got {len(row)}")
+            try:
+                vals = [float(row[k]) for k in (0, 1, 2, 3, 4)]
+            except ValueError as exc:
+                raise DataFileError(f"{where}: non-numeric value ({exc})") from None
+            bad = [(_COLUMNS[k], v) for k, v in zip((0, 1, 2, 3, 4), vals) if not math.isfinite(v)]
+            if bad:
+                raise DataFileError(f"{where}: column {bad[0][0]} = {bad[0][1]!r} is not finite")
+            if vals[0] != len(idx):
+                raise DataFileError(f"{where}: idx = {row[0]!r}, expected {len(idx)}")
+            idx.append(int(vals[0]))
+            pts.append([vals[1] / 100.0, -vals[2] / 100.0, vals[3] / 100.0])
+            roll.append(-math.radians(vals[4]))
+            sec.append(row[5].strip())
+    if len(idx) < 4:
+        raise DataFileError(f"{path}: only {len(idx)} data rows, need at least 4")
+    return CircuitData(np.array(pts), np.array(roll), np.array(sec), np.array(idx), path)
+
+
+def circuit_centreline(data: CircuitData | None = None, kind="quintic", n_gauss=8):
+    """Closed spline centreline through the circuit's control points.
+
+    Parameters
+    ----------
+    data : CircuitData, optional
+        Default: :func:`read_circuit` of the shared file.
+    kind : str
+        Spline kind of :class:`SplineCentreline` (quintic: C4, as a Frenet-locked body needs).
+
+    Returns
+    -------
+    SplineCentreline
+    """
+    data = read_circuit() if data is None else data
+    return SplineCentreline(data.points, kind=kind, closed=True, n_gauss=n_gauss,
+                            name=f"circuit {data.path.name} ({kind})")

@@ -345,6 +345,117 @@ class _DrivenPlanarJoint(UserConstraint):
         return -dh.T @ lam
 
 
+class _DrivenPlanarJoints(UserConstraint):
+    """All joints of the model as one constraint kind (3 rows per joint, vectorised over joints).
+
+    The same equations as :class:`_DrivenPlanarJoint` (module docstring), evaluated for every
+    joint in one numpy call: a Python constraint per joint costs its call overhead in every Newton
+    iteration of core's kinematic analysis; the functions of the coordinates are evaluated once per
+    time (cached by each joint).
+    """
+
+    name = "driven joints"
+
+    def __init__(self, joints, body_names):
+        self.joints = list(joints)
+        self.bodies = tuple(body_names)
+        self.coordinates = ()
+        self.rows = 3 * len(self.joints)
+        self.body_i = self.body_j = GROUND
+        self.at = None
+        index = {b: k for k, b in enumerate(self.bodies)}
+        self.P = np.array([index.get(j.jt.parent, -1) for j in self.joints])
+        self.C = np.array([index[j.jt.child] for j in self.joints])
+        self.sP = np.array([j.s_parent for j in self.joints])
+        self.sC = np.array([j.s_child for j in self.joints])
+        self.bP = np.array([j.jt.beta_parent for j in self.joints])
+        self.bC = np.array([j.jt.beta_child for j in self.joints])
+        self.has_parent = self.P >= 0
+        self._t_cached, self._cached = None, None
+
+    def _time_terms(self, t):
+        """Per joint: φ, t(q), R_F-free parts of ν and γ (module docstring), cached per time."""
+        if t != self._t_cached:
+            n = len(self.joints)
+            PH, TQ, V1, W1, A2, G2 = np.zeros(n), np.zeros((n, 2)), np.zeros((n, 2)), np.zeros(n), np.zeros((n, 2)), np.zeros(n)
+            for k, j in enumerate(self.joints):
+                qm, qd, qdd, ph, ph1, ph2, tq, t1, t2 = j._q(t)
+                PH[k], TQ[k] = ph, tq
+                if j.jt.coordinates:
+                    V1[k], W1[k] = t1 @ qd, ph1 @ qd
+                    A2[k], G2[k] = t2 @ (qd * qd) + t1 @ qdd, ph2 @ (qd * qd) + ph1 @ qdd
+            self._cached = (PH, TQ, V1, W1, A2, G2)
+            self._t_cached = t
+        return self._cached
+
+    def _poses(self, q, v=None):
+        x = q[self.q_index].reshape(-1, 3)
+        hp = self.has_parent
+        Pi = np.where(hp, self.P, 0)
+        rP = np.where(hp[:, None], x[Pi, :2], 0.0)
+        thP = np.where(hp, x[Pi, 2], 0.0)
+        rC, thC = x[self.C, :2], x[self.C, 2]
+        if v is None:
+            return rP, thP, rC, thC
+        w = v[self.v_index].reshape(-1, 3)[:, 2]
+        return rP, thP, rC, thC, np.where(hp, w[Pi], 0.0), w[self.C]
+
+    @staticmethod
+    def _rot(th, u):
+        c, s = np.cos(th), np.sin(th)
+        return np.stack([c * u[:, 0] - s * u[:, 1], s * u[:, 0] + c * u[:, 1]], axis=1)
+
+    @staticmethod
+    def _drot(th, u):
+        c, s = np.cos(th), np.sin(th)
+        return np.stack([-s * u[:, 0] - c * u[:, 1], c * u[:, 0] - s * u[:, 1]], axis=1)
+
+    def phi(self, t, q):
+        PH, TQ, *_ = self._time_terms(t)
+        rP, thP, rC, thC = self._poses(q)
+        thF = thP + self.bP
+        pos = rC + self._rot(thC, self.sC) - rP - self._rot(thP, self.sP) - self._rot(thF, TQ)
+        ang = thC + self.bC - thP - self.bP - PH
+        return np.column_stack([pos, ang]).ravel()
+
+    def jacobian(self, t, q):
+        PH, TQ, *_ = self._time_terms(t)
+        rP, thP, rC, thC = self._poses(q)
+        thF = thP + self.bP
+        n = len(self.joints)
+        J = np.zeros((3 * n, 3 * len(self.bodies)))
+        r0 = 3 * np.arange(n)
+        c0 = 3 * self.C
+        J[r0, c0] = 1.0
+        J[r0 + 1, c0 + 1] = 1.0
+        dC = self._drot(thC, self.sC)
+        J[r0, c0 + 2] = dC[:, 0]
+        J[r0 + 1, c0 + 2] = dC[:, 1]
+        J[r0 + 2, c0 + 2] = 1.0
+        k = np.nonzero(self.has_parent)[0]
+        p0 = 3 * self.P[k]
+        dP = -self._drot(thP[k], self.sP[k]) - self._drot(thF[k], TQ[k])
+        J[r0[k], p0] = -1.0
+        J[r0[k] + 1, p0 + 1] = -1.0
+        J[r0[k], p0 + 2] = dP[:, 0]
+        J[r0[k] + 1, p0 + 2] = dP[:, 1]
+        J[r0[k] + 2, p0 + 2] = -1.0
+        return J
+
+    def nu(self, t, q):
+        _, _, V1, W1, _, _ = self._time_terms(t)
+        rP, thP, rC, thC = self._poses(q)
+        return np.column_stack([self._rot(thP + self.bP, V1), W1]).ravel()
+
+    def gamma(self, t, q, v):
+        _, TQ, V1, _, A2, G2 = self._time_terms(t)
+        rP, thP, rC, thC, wP, wC = self._poses(q, v)
+        thF = thP + self.bP
+        g = (wC[:, None] ** 2 * self._rot(thC, self.sC) - wP[:, None] ** 2 * self._rot(thP, self.sP)
+             - wP[:, None] ** 2 * self._rot(thF, TQ) + 2.0 * wP[:, None] * self._drot(thF, V1) + self._rot(thF, A2))
+        return np.column_stack([g, G2]).ravel()
+
+
 class SagittalModel:
     """A built core model of a sagittal OpenSim model with its coordinates driven.
 
@@ -355,12 +466,25 @@ class SagittalModel:
     coordinates : list of str
         The driven coordinates, in the model file's order.
     joints : list of _DrivenPlanarJoint
-        The user constraints, one per OpenSim joint.
+        One per OpenSim joint, each bound to the model's coordinates of its two bodies; the model
+        holds them as one vectorised constraint (:class:`_DrivenPlanarJoints`).
+    rows : dict of str to (3,) int arrays
+        The model's constraint rows of each joint (position x, y, angle).
     """
 
     def __init__(self, model, osim, joints, coordinates, kinematics):
         self.model, self.osim, self.joints, self.coordinates = model, osim, joints, coordinates
         self.kinematics = kinematics
+        all_rows = model.reaction_groups()[_DrivenPlanarJoints.name]
+        if len(all_rows) != 3 * len(joints):
+            raise ModelError(f"{osim.name}: dependent joint equations were removed at build; the driven "
+                             "model must have independent constraints")
+        self.rows = {uc.name: all_rows[3 * k:3 * k + 3] for k, uc in enumerate(joints)}
+        for uc in joints:  # the per-joint objects evaluate on the model's coordinates
+            blocks = [b for b in (uc.jt.parent, uc.jt.child) if b != GROUND]
+            qi = np.concatenate([np.arange(model.n_q)[model.q_slice(b)] for b in blocks])
+            vi = np.concatenate([np.arange(model.n_v)[model.v_slice(b)] for b in blocks])
+            uc.bind(qi, vi, model.space)
 
     def generalized_forces(self, t, q, lam) -> pd.DataFrame:
         """OpenSim-named generalized forces per frame from core's multipliers.
@@ -368,12 +492,11 @@ class SagittalModel:
         ``t`` (n,), ``q`` (n, n_q) Cartesian coordinates, ``lam`` (n, n_c) multipliers.
         Columns ``time [s]`` and ``<coordinate>_moment [N m]`` / ``<coordinate>_force [N]``.
         """
-        groups = self.model.reaction_groups()
         cols = {"time [s]": np.asarray(t, float)}
         ctype = {c.name: c.motion_type for c in self.osim.coordinates}
         vals = {c: np.zeros(len(t)) for c in self.coordinates}
         for uc in self.joints:
-            rows = groups[uc.name]
+            rows = self.rows[uc.name]
             for i in range(len(t)):
                 tau = uc.generalized_forces(q[i], float(t[i]), lam[i, rows])
                 for c, v in zip(uc.jt.coordinates, tau):
@@ -394,10 +517,9 @@ class SagittalModel:
         ``<joint>_on_<child>_Fx [N]``, ``_Fy [N]`` (OpenSim's JointReaction analysis reports the same
         force, child side, when expressed in ground).
         """
-        groups = self.model.reaction_groups()
         cols = {"time [s]": np.asarray(t, float)}
         for uc in self.joints:
-            rows = groups[uc.name]
+            rows = self.rows[uc.name]
             F = -np.asarray(lam)[:, rows[:2]]
             cols[f"{uc.name}_on_{uc.jt.child}_Fx [N]"] = F[:, 0]
             cols[f"{uc.name}_on_{uc.jt.child}_Fy [N]"] = F[:, 1]
@@ -459,9 +581,8 @@ def build_sagittal_model(osim, kinematics, loads=None, name=None):
 
         cP = np.zeros(2) if jt.parent == GROUND else np.asarray(bodies[jt.parent].mass_center, float)[:2]
         cC = np.asarray(bodies[jt.child].mass_center, float)[:2]
-        uc = _DrivenPlanarJoint(jt, motion, cP, cC)
-        b.add_joint(uc)
-        joints.append(uc)
+        joints.append(_DrivenPlanarJoint(jt, motion, cP, cC))
+    b.add_joint(_DrivenPlanarJoints(joints, [body.name for body in osim.bodies]))
     if loads is not None:
         if len(loads.time) != len(times) or not np.allclose(loads.time, times, rtol=0.0, atol=1e-9):
             raise InputError(f"external loads {loads.source}: sampled at {len(loads.time)} times, the kinematics at "

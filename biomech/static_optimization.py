@@ -162,6 +162,96 @@ class _Attempt:
     reserve_controls: np.ndarray | None
 
 
+class _ClarabelData:
+    """Clarabel's problem data as a fixed-pattern linear map of the parameters.
+
+    cvxpy canonicalises the DPP problem once into a tensor T with [A | b] = T p (p the vector of
+    parameter values plus a one); ``problem.solve`` then rebuilds scipy sparse matrices from it and
+    reformats them for every frame, which costs ten times Clarabel's own solve on the 18-muscle
+    model.  Here the same tensor of cvxpy (``ParamConeProg.reduced_A``, kept with its explicit
+    zeros so the sparsity pattern is fixed) is applied as one sparse matrix-vector product per
+    frame and its values are written into the fixed pattern: Clarabel's A = -T_A p, b = T_b p (the
+    signs of cvxpy's Clarabel interface), cones from cvxpy's cone dimensions, P and q constant (the
+    criterion has no parameter in its objective; checked on the first two frames).  The map is
+    verified against ``problem.get_problem_data`` on the first two frames, and a frame whose status
+    is not 'optimal' is solved again by ``problem.solve`` (with the retries), so the reported
+    solution always comes from one of the two equal routes.
+    """
+
+    def __init__(self, problem, cp, variables):
+        from cvxpy.cvxcore.python import canonInterface
+        from cvxpy.reductions.solvers.conic_solvers.clarabel_conif import CLARABEL, dims_to_solver_cones
+
+        self._ci, self._clarabel_if = canonInterface, CLARABEL
+        data, _, _ = problem.get_problem_data(cp.CLARABEL, enforce_dpp=True)
+        pp = data[cp.settings.PARAM_PROB]
+        self.pp = pp
+        ra = pp.reduced_A
+        ra.cache(keep_zeros=True)
+        self.T = ra.reduced_mat.tocsr()
+        indices, indptr, shape = ra.problem_data_index
+        self.nA = int(indptr[-2])
+        self.A_indices = np.asarray(indices[: self.nA])
+        self.A_indptr = np.asarray(indptr[:-1])
+        self.A_shape = (int(shape[0]), int(shape[1]) - 1)
+        self.b_rows = np.asarray(indices[self.nA:])
+        self.P = data["P"] if "P" in data else None
+        self.q = np.asarray(data["c"], float)
+        self.cones = dims_to_solver_cones(data["dims"])
+        self.cols = [(pp.var_id_to_col[v.id], v.size) for v in variables]
+        self.solver = None
+        self.verified = 0
+        self.ok = self._matches(data)
+
+    def _param_vec(self):
+        pp = self.pp
+        return self._ci.get_parameter_vector(pp.total_param_size, pp.param_id_to_col, pp.param_id_to_size,
+                                             lambda i: np.asarray(pp.id_to_param[i].value))
+
+    def data(self):
+        import scipy.sparse as sp
+
+        flat = self.T @ self._param_vec()
+        A = sp.csc_array((-flat[: self.nA], self.A_indices, self.A_indptr), shape=self.A_shape)
+        b = np.zeros(self.A_shape[0])
+        b[self.b_rows] = flat[self.nA:]
+        return A, b
+
+    def _matches(self, data):
+        A, b = self.data()
+        ok = (A.shape == data["A"].shape and abs(A - data["A"]).max() <= 1e-12 * max(1.0, abs(data["A"]).max())
+              and np.allclose(b, data["b"], rtol=1e-12, atol=1e-12))
+        return bool(ok)
+
+    def verify(self, problem, cp):
+        """Compare the map with cvxpy's data at the current parameters (first frames)."""
+        data, _, _ = problem.get_problem_data(cp.CLARABEL, enforce_dpp=True)
+        same_obj = np.array_equal(np.asarray(data["c"], float), self.q) and (
+            (self.P is None and "P" not in data) or (self.P is not None and abs(data["P"] - self.P).max() == 0))
+        self.ok = self.ok and same_obj and self._matches(data)
+        self.verified += 1
+        return self.ok
+
+    def solve(self, options):
+        """(status, solver time, iterations, [variable values]) with cvxpy's status names."""
+        import clarabel
+        import scipy.sparse as sp
+
+        A, b = self.data()
+        n = self.A_shape[1]
+        P = sp.triu(self.P if self.P is not None else sp.csc_array((n, n))).tocsc()
+        settings = self._clarabel_if.parse_solver_opts(False, options)
+        if self.solver is None or not self.solver.is_data_update_allowed():
+            self.solver = clarabel.DefaultSolver(P, self.q, A, b, self.cones, settings)
+        else:
+            self.solver.update(A=A, b=b, settings=settings)
+        sol = self.solver.solve()
+        status = self._clarabel_if.STATUS_MAP.get(str(sol.status), "solver_error")
+        x = np.asarray(sol.x, float)
+        values = [x[c:c + k] for c, k in self.cols]
+        return str(status), float(sol.solve_time), int(sol.iterations), values
+
+
 @dataclass
 class FrameSolution:
     """Solution of one frame.
@@ -263,6 +353,12 @@ class StaticOptimization:
         How sum |x|^p is written when it is neither a plain sum nor a sum of squares of a variable:
         ``"soc"`` (default), cvxpy's ``power`` atom (second-order cones; exact for integer p such
         as 3); ``"power_cone"``, the epigraph t >= |x|^p as Clarabel's native 3-D power cones.
+    fast_path : bool
+        Solve each frame's first attempt through cvxpy's parameter tensor applied directly
+        (:class:`_ClarabelData`: one sparse product per frame instead of rebuilding the solver's
+        matrices; verified against ``problem.get_problem_data`` on the first two frames; a frame
+        that does not end 'optimal' is solved again by ``problem.solve``).  ``False`` uses
+        ``problem.solve`` for every frame (the constraints' ``dual_value`` are then set).
     retry_options : sequence of dict
         Clarabel settings tried in turn when a frame ends with a solver failure or an inaccurate
         status (default :data:`DEFAULT_RETRY_OPTIONS`); each retry is listed in the frame's
@@ -299,7 +395,8 @@ class StaticOptimization:
                  specific_tension: float = SPECIFIC_TENSION, reserve_optimal_force=None, reserve_bounds=None,
                  reserve_weight: float = 1.0, activation_bounds=(0.0, 1.0),
                  coordinate_units: Sequence[str] | None = None, solver_options: dict | None = None,
-                 epigraph: str = "soc", retry_options: Sequence[dict] = DEFAULT_RETRY_OPTIONS):
+                 epigraph: str = "soc", retry_options: Sequence[dict] = DEFAULT_RETRY_OPTIONS,
+                 fast_path: bool = True):
         import clarabel
         import cvxpy as cp  # cvxpy is imported only inside biomech (DESIGN.md)
 
@@ -402,6 +499,8 @@ class StaticOptimization:
         self._base_options = {key: getattr(defaults, key) for r in self.retry_options for key in r}
         self._base_options.update(self.solver_options)
         self._build(cp)
+        self._fast_enabled = bool(fast_path)
+        self._fast = None
 
     # ------------------------------------------------------------------------------------------
     @staticmethod
@@ -582,7 +681,9 @@ class StaticOptimization:
         if self._c is not None:
             self._c.value = A / self.stress_force_scale
             self._d.value = P / self.stress_force_scale
-        first = self._run(self.problem, self._base_options)
+        first = self._run_fast() if self._fast_enabled else None
+        if first is None:
+            first = self._run(self.problem, self._base_options)
         best, solver_time, notes = first, first.solver_time, []
         for retry in self.retry_options:
             if _rank(best.status) == 2:
@@ -618,6 +719,30 @@ class StaticOptimization:
         residual = R @ forces + self.G @ u - tau
         return FrameSolution(a, forces, u, reserve_forces, residual, status, message,
                              self.objective_value(a, u, A, P), elapsed, solver_time, iters)
+
+    def _run_fast(self):
+        """The frame through :class:`_ClarabelData` (cvxpy's parameter tensor applied directly); None
+        where it cannot be used or did not end 'optimal' (the caller then solves with cvxpy)."""
+        cp = self._cp
+        try:
+            if self._fast is None:
+                variables = [self._a] + ([self._u] if self.n_reserves else [])
+                self._fast = _ClarabelData(self.problem, cp, variables)
+                self._fast.verified = 1
+            elif self._fast.verified < 2:
+                self._fast.verify(self.problem, cp)
+            if not self._fast.ok:
+                self._fast_enabled = False
+                return None
+            status, solve_time, iters, values = self._fast.solve(self._base_options)
+        except Exception:  # an internal API of cvxpy that changed: use problem.solve from now on
+            self._fast_enabled = False
+            return None
+        if status != "optimal":
+            return None
+        a = values[0]
+        u = values[1] if self.n_reserves else np.zeros(0)
+        return _Attempt(status, "", solve_time, iters, a, u)
 
     def _run(self, problem, options) -> _Attempt:
         """Solve ``problem`` with Clarabel and keep a copy of the main problem's solution."""

@@ -154,7 +154,8 @@ def test_moment_equations_bounds_and_kkt(criterion, exponent):
     rng = np.random.default_rng(2)
     muscles, coords, pattern = synthetic_model(rng, 3, 9)
     so = StaticOptimization.from_muscles(muscles, coords, criterion=criterion, exponent=exponent,
-                                         reserve_optimal_force=[1.0, 2.0, 0.0], epigraph="power_cone")
+                                         reserve_optimal_force=[1.0, 2.0, 0.0], epigraph="power_cone",
+                                         fast_path=False)  # the duals come from cvxpy's own solve
     frames = [synthetic_frames(rng, muscles, pattern, 15), saturating_frames(rng, muscles, pattern, 10)]
     n_upper = n_lower = 0
     worst = [0.0, 0.0]
@@ -339,7 +340,8 @@ def test_solver_failure_is_a_status_not_an_exception(monkeypatch):
     rng = np.random.default_rng(7)
     muscles, coords, pattern = synthetic_model(rng, 3, 9)
     R, A, P, tau = synthetic_frames(rng, muscles, pattern, 4)
-    so = StaticOptimization.from_muscles(muscles, coords, reserve_optimal_force=1.0)
+    # the failure is injected into cvxpy's problem.solve: the direct route is switched off here
+    so = StaticOptimization.from_muscles(muscles, coords, reserve_optimal_force=1.0, fast_path=False)
     real_solve = so.problem.solve
     calls = []
 
@@ -355,6 +357,40 @@ def test_solver_failure_is_a_status_not_an_exception(monkeypatch):
     assert "retried with" in df.loc[1, "message"] and np.isnan(df.loc[1, "a_m00 [-]"])
     # retries changed max_step_fraction; the next frame is solved with the default again
     assert calls[-1]["max_step_fraction"] == 0.99
+
+
+@pytest.mark.parametrize("criterion", ["activation", "stress"])
+def test_direct_route_equals_cvxpy_solve(criterion):
+    """The per-frame route through cvxpy's parameter tensor (_ClarabelData) gives the solution of
+    problem.solve: same statuses, activations and reserves to the solver's tolerance."""
+    rng = np.random.default_rng(11)
+    muscles, coords, pattern = synthetic_model(rng, 4, 12)
+    R, A, P, tau = synthetic_frames(rng, muscles, pattern, 12)
+    fast = StaticOptimization.from_muscles(muscles, coords, criterion=criterion, reserve_optimal_force=1.0)
+    slow = StaticOptimization.from_muscles(muscles, coords, criterion=criterion, reserve_optimal_force=1.0,
+                                           fast_path=False)
+    a = fast.solve_trial(np.arange(12), R, A, P, tau)
+    b = slow.solve_trial(np.arange(12), R, A, P, tau)
+    assert fast._fast is not None and fast._fast.ok and fast._fast.verified == 2  # the route was used
+    assert list(a["status"]) == list(b["status"]) == ["optimal"] * 12
+    cols = [c for c in a.columns if c.startswith(("a_", "u_"))]
+    np.testing.assert_allclose(a[cols].to_numpy(), b[cols].to_numpy(), atol=1e-6)
+
+
+def test_direct_route_failure_falls_back_to_cvxpy(monkeypatch):
+    from biomech import static_optimization as so_mod
+
+    rng = np.random.default_rng(12)
+    muscles, coords, pattern = synthetic_model(rng, 3, 9)
+    R, A, P, tau = synthetic_frames(rng, muscles, pattern, 3)
+    so = StaticOptimization.from_muscles(muscles, coords, reserve_optimal_force=1.0)
+
+    def broken(self, options):
+        raise RuntimeError("an internal API of cvxpy changed")
+
+    monkeypatch.setattr(so_mod._ClarabelData, "solve", broken)
+    df = so.solve_trial(np.arange(3), R, A, P, tau)
+    assert (df["status"] == "optimal").all() and not so._fast_enabled
 
 
 # ---- status and speed on larger random sets --------------------------------------------------

@@ -49,15 +49,20 @@ def _start(wheel, rails, y0, E, nu):
     return float(z[0]), float(roll[0]), float(np.mean(res.rolling_radius[i, c])), float(np.mean(h.delta))
 
 
+def _setup(wheel, rails, y0, contact, track_length, s0, name):
+    """Profiles (S1002 / UIC60 1:40 by default), the statically loaded start (:func:`_start`), a
+    straight track and a spatial model builder: what both wheelset models share."""
+    wheel = wheel if wheel is not None else WheelProfile.s1002()
+    rails = rails if rails is not None else RailMounting()
+    z, roll, r, delta = _start(wheel, rails, y0, contact.get("E", 2.1e11), contact.get("nu", 0.28))
+    track = Track.straight(track_length or max(400.0, s0 + 10.0))
+    return wheel, rails, z, roll, r, delta, track, ModelBuilder(3, name, gravity=(0.0, 0.0, -GRAVITY))
+
+
 def free_wheelset(speed, y0, wheel=None, rails=None, creep_law="kalker_linear", creep_params=None,
                   track_length=None, s0=10.0, mu=0.3, name="free wheelset", **contact):
     """A free wheelset released at lateral offset y0 (m) at speed V (module docstring)."""
-    wheel = wheel if wheel is not None else WheelProfile.s1002()
-    rails = rails if rails is not None else RailMounting()
-    E, nu = contact.get("E", 2.1e11), contact.get("nu", 0.28)
-    z, roll, r, delta = _start(wheel, rails, y0, E, nu)
-    track = Track.straight(track_length or max(400.0, s0 + 10.0))
-    b = ModelBuilder(3, name, gravity=(0.0, 0.0, -GRAVITY))
+    wheel, rails, z, roll, r, delta, track, b = _setup(wheel, rails, y0, contact, track_length, s0, name)
     b.add_body("wheelset", position=(s0, y0, z - delta),
                orientation=frames.rotation_vector_to_euler(np.array([roll, 0.0, 0.0])),
                velocity=(speed, 0.0, 0.0), angular_velocity=(0.0, speed / r, 0.0), **WHEELSET)
@@ -75,12 +80,7 @@ def suspended_wheelset(speed, k_y, k_psi, y0=0.0, wheel=None, rails=None, creep_
     the contact adds the nominal spin V / r."""
     from core.drivers import polynomial
 
-    wheel = wheel if wheel is not None else WheelProfile.s1002()
-    rails = rails if rails is not None else RailMounting()
-    E, nu = contact.get("E", 2.1e11), contact.get("nu", 0.28)
-    z, roll, r, delta = _start(wheel, rails, y0, E, nu)
-    track = Track.straight(track_length or max(400.0, s0 + 10.0))
-    b = ModelBuilder(3, name, gravity=(0.0, 0.0, -GRAVITY))
+    wheel, rails, z, roll, r, delta, track, b = _setup(wheel, rails, y0, contact, track_length, s0, name)
     zc = z - delta
     spin = speed / r
     b.add_body("wheelset", position=(s0, y0, zc),

@@ -227,6 +227,55 @@ class FrenetFrame(FramedCurve):
         """(r, r', r'', R, omega, omega') exactly from the centreline (see the class)."""
         return self._from_derivatives(s, self.centreline.derivatives(s))
 
+    def check(self, L=None, n=2001):
+        """Check that the frame is defined and continuous along the track; raise where it is not.
+
+        Pointwise evaluation only raises where kappa < kappa_min at a requested L; near an
+        inflection the curvature is small but non-zero at the samples and n = g''/kappa turns
+        by about pi between two of them (the centre of curvature changes side).  This scan
+        evaluates the frame at ``L`` (default ``n`` points over the track plus the breaks) and
+        reports the first place where it is undefined (no fallback) or where the normals of two
+        neighbouring samples point apart (n_i . n_{i+1} < 0: a flip, which a body locked to the
+        frame would follow by turning over).
+
+        Parameters
+        ----------
+        L : array_like, optional
+            Arc lengths (m), increasing.
+        n : int
+            Number of equally spaced samples when ``L`` is not given.
+
+        Returns
+        -------
+        float
+            The largest rotation angle (rad) between neighbouring samples' frames.
+
+        Raises
+        ------
+        InputError
+            kappa < kappa_min at some L without a fallback (named), or a flip of the frame
+            between L_i and L_{i+1} (both named, with the angle).
+        """
+        c = self.centreline
+        if L is None:
+            L = np.unique(np.concatenate([np.linspace(0.0, c.length, int(n)), np.asarray(c.breaks, float)]))
+        L = np.atleast_1d(np.asarray(L, dtype=float)).reshape(-1)
+        R = self.frame(L)[0]  # raises where undefined without a fallback
+        if L.size < 2:
+            return 0.0
+        nn = R[:, :, 1]
+        dots = _dot(nn[:-1], nn[1:])
+        rel = np.einsum("nki,nkj->nij", R[:-1], R[1:])
+        ang = np.arccos(np.clip((np.trace(rel, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+        flip = dots < 0.0
+        if np.any(flip):
+            i = int(np.argmax(flip))
+            raise InputError(f"{self.name}: the Frenet frame flips by {float(ang[i]):.3g} rad between L = "
+                             f"{float(L[i])!r} m and L = {float(L[i + 1])!r} m (normal n_i . n_(i+1) = "
+                             f"{float(dots[i]):.3g}): an inflection, where the curvature changes side; use a "
+                             f"RotationMinimisingFrame")
+        return float(np.max(ang))
+
 
 # ---------------------------------------------------------------------------------------------
 # rotation-minimising frame with bank

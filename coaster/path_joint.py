@@ -326,6 +326,17 @@ class PathFollowingJoint(UserConstraint):
         P = np.array([self._generalized(qq, ll)[:6] @ vv[self.v_index[:6]] for qq, vv, ll in zip(Q, V, Lm)])
         return float(P[0]) if np.ndim(q) == 1 else P
 
+    def compiled(self, layout):
+        """Compiled form for core's fast integrators (:func:`coaster._kernels.path_joint_kernel`).
+
+        Needs a tabulated track (:class:`core.curves.TabulatedFramedCurve`, e.g. the table of a
+        :class:`coaster.frames.RotationMinimisingFrame`); otherwise
+        :class:`core.errors.NotCompilable` names the joint.
+        """
+        from ._kernels import compile_path_joint
+
+        return compile_path_joint(self, layout)
+
     def reaction_table(self, model, result):
         """Reactions of a :class:`core.results.SimulationResult` as a DataFrame in the track frame.
 

@@ -36,6 +36,7 @@ import abc
 import csv
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 from pathlib import Path
 
 import numpy as np
@@ -55,7 +56,9 @@ __all__ = [
     "SplineCentreline",
     "Straight",
     "VerticalLoop",
+    "Clearance",
     "chain",
+    "check_clearance",
     "circuit_centreline",
     "read_circuit",
     "CIRCUIT_FILE",
@@ -216,8 +219,8 @@ class SplineCentreline(Centreline):
     Raises
     ------
     InputError
-        Fewer than 4 points, a non-finite coordinate, or two consecutive equal points (the
-        message names the index), an unknown kind or end condition.
+        Fewer than 4 points, a non-finite coordinate, two equal points, consecutive or not
+        (the message names both indices), an unknown kind or end condition.
 
     References
     ----------
@@ -260,7 +263,15 @@ class SplineCentreline(Centreline):
         Y = np.vstack([P, P[:1]]) if closed else P
         if not closed:
             u = u[: P.shape[0]]
-        self._fit(u, Y)
+        self._fit(u, Y)  # first: a shape-preserving cusp (a retraced track) is the more specific error
+        # a repeated point further along passes the track through the same place twice
+        from scipy.spatial import cKDTree
+
+        pairs = sorted(cKDTree(P).query_pairs(1e-12 * scale))
+        if pairs:
+            i, j = pairs[0]
+            raise InputError(f"{self.name}: control points {i} and {j} coincide ({P[i].tolist()}): a duplicate "
+                             f"control point (the track would pass the same place twice); remove it")
         self._arc_length()
         self.L_points = self._L_of_u(u[: P.shape[0]])
         self.breaks = self.L_knots
@@ -719,6 +730,126 @@ def chain(segments, start=(0.0, 0.0, 0.0), heading=0.0):
         psi_prev = math.atan2(end[1, 0, 1], end[1, 0, 0])
         out.append(new)
     return out
+
+
+# ---------------------------------------------------------------------------------------------
+# self-intersection within the gauge
+# ---------------------------------------------------------------------------------------------
+class Clearance(NamedTuple):
+    """Result of :func:`check_clearance`: the closest approach of non-neighbouring track points.
+
+    Attributes
+    ----------
+    distance : float
+        |g(L_a) - g(L_b)| (m); inf when no pair of non-neighbours came within
+        ``clearance + spacing``.
+    L_a, L_b : float
+        Arc lengths of the two points (m), L_a < L_b (NaN with distance inf).
+    clearance : float
+        The required clearance (m).
+    window : float
+        Along-track separation (m) below which two points count as neighbours.
+    """
+
+    distance: float
+    L_a: float
+    L_b: float
+    clearance: float
+    window: float
+
+
+def check_clearance(centreline: Centreline, clearance, spacing=None, raise_error=True) -> Clearance:
+    """Check that a track does not come back within ``clearance`` of itself (self-intersection).
+
+    Two track points g(L_a), g(L_b) are *neighbours* when their along-track separation
+    d(L_a, L_b) = |L_b - L_a| (on a closed track min(|L_b - L_a|, length - |L_b - L_a|)) is at
+    most the window w = (pi/2) c, c the clearance (e.g. the wheel gauge plus the car's width).
+    Non-neighbours must stay at least c apart::
+
+        min { |g(L_a) - g(L_b)| : d(L_a, L_b) > w } >= c
+
+    Why w = (pi/2) c: on an arc of radius rho the chord over a separation s is 2 rho sin(s/2 rho)
+    >= (2/pi) s for s <= pi rho, so points more than w apart along a track that curves no tighter
+    than rho = c/2 are more than c apart; only a genuine return of the track (a loop without
+    enough lateral offset, helix turns closer than c, a crossing) or a curve tighter than its own
+    gauge (rho < c/2) is reported.
+
+    Method: samples every ``spacing`` (default c/4) into a k-d tree; pairs of non-neighbours
+    closer than c + spacing (the most two samples can overestimate a distance) are refined by
+    bounded minimisation of |g(a) - g(b)|^2 in (a, b) with its exact gradient
+    (d.g'(a), -d.g'(b)), d = g(a) - g(b), within one spacing of the samples.
+
+    Parameters
+    ----------
+    centreline : Centreline
+    clearance : float
+        c (m), positive.
+    spacing : float, optional
+        Sample spacing (m); default c/4.
+    raise_error : bool
+        Raise on a violation (default) or only return the closest approach.
+
+    Returns
+    -------
+    Clearance
+
+    Raises
+    ------
+    InputError
+        A non-positive clearance or spacing, or (``raise_error``) a track that comes within c of
+        itself: the message names both arc lengths and the distance.
+    """
+    from scipy.optimize import minimize
+    from scipy.spatial import cKDTree
+
+    name = getattr(centreline, "name", "centreline")
+    c = float(clearance)
+    if not (np.isfinite(c) and c > 0):
+        raise InputError(f"{name}: clearance must be positive and finite (m), got {clearance!r}")
+    h = c / 4.0 if spacing is None else float(spacing)
+    if not (np.isfinite(h) and h > 0):
+        raise InputError(f"{name}: spacing must be positive and finite (m), got {spacing!r}")
+    w = 0.5 * math.pi * c
+    Ltot = float(centreline.length)
+    n = max(2, int(math.ceil(Ltot / h)) + 1)
+    L = np.linspace(0.0, Ltot, n)
+    if centreline.closed:
+        L = L[:-1]
+    P = centreline.derivatives(L)[0]
+    pairs = np.array(sorted(cKDTree(P).query_pairs(c + h)), dtype=int).reshape(-1, 2)
+
+    def sep(a, b):
+        d = np.abs(b - a)
+        return np.minimum(d, Ltot - d) if centreline.closed else d
+
+    if pairs.size:
+        pairs = pairs[sep(L[pairs[:, 0]], L[pairs[:, 1]]) > w]
+    best = Clearance(float("inf"), float("nan"), float("nan"), c, w)
+    if pairs.size:
+        dist = np.linalg.norm(P[pairs[:, 0]] - P[pairs[:, 1]], axis=1)
+        order = np.argsort(dist)[:64]
+
+        def f(x):
+            d = centreline.derivatives(x)
+            e = d[0, 0] - d[0, 1]
+            return float(e @ e), np.array([2 * e @ d[1, 0], -2 * e @ d[1, 1]])
+
+        for k in order:
+            a0, b0 = L[pairs[k, 0]], L[pairs[k, 1]]
+            bounds = [(a0 - h, a0 + h), (b0 - h, b0 + h)]
+            if not centreline.closed:
+                bounds = [(max(0.0, lo), min(Ltot, hi)) for lo, hi in bounds]
+            res = minimize(f, np.array([a0, b0]), jac=True, method="L-BFGS-B", bounds=bounds)
+            x = res.x if res.fun <= dist[k] ** 2 else np.array([a0, b0])
+            d = math.sqrt(min(float(res.fun), float(dist[k]) ** 2))
+            if sep(x[0], x[1]) > w and d < best.distance:
+                la, lb = (x % Ltot if centreline.closed else x)
+                best = Clearance(d, float(min(la, lb)), float(max(la, lb)), c, w)
+    if raise_error and best.distance < c:
+        raise InputError(f"{name}: the track comes within {best.distance:.4g} m of itself between L = "
+                         f"{best.L_a:.6g} m and L = {best.L_b:.6g} m (clearance {c:g} m, neighbours within "
+                         f"{w:.4g} m along the track excluded): it self-intersects within the gauge")
+    return best
 
 
 # ---------------------------------------------------------------------------------------------

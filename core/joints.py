@@ -364,10 +364,14 @@ class UserConstraint:
         Bodies whose coordinates it uses (their full blocks are included in v_index).
     coordinates : list of str
         Extra coordinates (added with ``ModelBuilder.add_coordinate``) it uses.
+    time_dependent : bool
+        Φ depends on time explicitly (a driver); the model then counts as non-conservative.
     """
 
     name: str = "user"
     rows: int = 1
+    #: True when Φ depends on time explicitly (ν ≠ 0); the model is then not conservative
+    time_dependent: bool = False
     bodies: tuple[str, ...] = ()
     coordinates: tuple[str, ...] = ()
     body_i: str = "ground"
@@ -406,3 +410,58 @@ class UserConstraint:
 
         raise NotCompilable(f"user constraint {self.name!r} ({type(self).__name__}) has no compiled kernel; "
                             "give it a compiled() method (see core.compiled) or use the numpy integrators")
+
+
+class CoordinateDriver(UserConstraint):
+    r"""Prescribe an extra coordinate of the model as a function of time: ``Φ = x − f(t) = 0``.
+
+    One row on the extra coordinate ``x`` (added with ``ModelBuilder.add_coordinate``):
+    ``Φ_x = 1``, ``ν = ḟ(t)``, ``γ = f̈(t)`` (from ``Φ̈ = ẍ − f̈ = 0``).  Its multiplier λ is the
+    generalized force the driver exerts, ``Q_x = −λ`` (N for a length coordinate): e.g. the chain of
+    a lift hill pulling a path parameter.  ``motion`` is anything :func:`core.drivers.as_time_function`
+    accepts; the closed forms and tables (``constant``, ``polynomial``, ``ramp``, ``harmonic``,
+    ``tabulated``) also run on the compiled path.
+
+    Parameters
+    ----------
+    name : str
+    coordinate : str
+        Name of the extra coordinate.
+    motion : number, callable, (times, values) or TimeFunction
+        f(t) in the coordinate's unit.
+
+    References
+    ----------
+    Haug, E. J. (1989). Computer-Aided Kinematics and Dynamics of Mechanical Systems, Sec. 3.5
+    (driving constraints ``Φ^D(q, t) = 0`` with ``ν = −Φ^D_t``, ``γ ⊃ −Φ^D_tt``).
+    """
+
+    rows = 1
+    time_dependent = True
+
+    def __init__(self, name: str, coordinate: str, motion):
+        self.name = str(name)
+        self.coordinate = str(coordinate)
+        self.coordinates = (self.coordinate,)
+        self.bodies = ()
+        self.body_i = self.body_j = "ground"
+        self.at = None
+        self.function: TimeFunction = as_time_function(motion, label=f"driver {self.name!r}")
+
+    def phi(self, t, q):
+        return np.array([q[self.q_index[0]] - self.function(t)[0]])
+
+    def jacobian(self, t, q):
+        return np.ones((1, 1))
+
+    def nu(self, t, q):
+        return np.array([self.function(t)[1]])
+
+    def gamma(self, t, q, v):
+        return np.array([self.function(t)[2]])
+
+    def compiled(self, layout):
+        """Compiled form: :func:`core.compiled.elements.coordinate_driver` (fd: the program of f)."""
+        from .compiled.elements import compile_coordinate_driver
+
+        return compile_coordinate_driver(self, layout)

@@ -610,7 +610,8 @@ class Model(ConstrainedSystem):
             fgroups.setdefault(type(f), []).append(f)
         self.force_elements = tuple(b.forces.values())
         self.force_kinds: list[ForceKind] = [cls_.compile(els, ctx) for cls_, els in fgroups.items()]
-        self.time_dependent = any(k.time_dependent for k in self.kinds)
+        self.time_dependent = (any(k.time_dependent for k in self.kinds)
+                               or any(getattr(uc, "time_dependent", False) for uc in self.user_constraints))
         self.is_conservative = all(fk.conservative for fk in self.force_kinds) and not self.time_dependent
         self._reaction_points = {}
         for j in self.joints:

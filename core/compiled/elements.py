@@ -1096,3 +1096,35 @@ __all__ = [
     "bump_stops", "series_spring_dampers", "series_spring_dampers_jacobian",
 ]
 
+
+
+# --- driver of an extra coordinate (core.joints.CoordinateDriver) ---------------------------------
+
+
+@constraint_kernel
+def coordinate_driver(t, q, v, r, A, rd, w, lay, fd, ix, row0, flags, phi, G, nu, gam, err):
+    """``Φ = x − f(t)``, ``Φ_x = 1``, ``ν = ḟ``, ``γ = f̈`` (fd: the program of f; ix: q index of x)."""
+    st, f, fdot, fddot = tf_evaluate(fd[0, :], t)
+    if st != OK:
+        err[1] = 0
+        return st
+    if flags & WANT_PHI:
+        phi[row0] = q[ix[0, 0]] - f
+    for j in range(6):
+        G[row0, 0, j] = 0.0
+    G[row0, 0, 0] = 1.0
+    if flags & WANT_NU:
+        nu[row0] = fdot
+    if flags & WANT_GAMMA:
+        gam[row0] = fddot
+    return OK
+
+
+def compile_coordinate_driver(driver, layout) -> CompiledConstraints:
+    """Pack a :class:`core.joints.CoordinateDriver` (one element, one row on its coordinate)."""
+    owner = f"driver {driver.name!r}"
+    fd = encode_rows([driver.function], [owner])
+    slots = np.array([[layout.extra_slot(driver.coordinate, owner), -1, -1]], np.int64)
+    ix = np.array([[layout.extra_q_index(driver.coordinate, owner)]], np.int64)
+    return CompiledConstraints(kernel=coordinate_driver, fd=np.ascontiguousarray(fd), ix=ix, rows=1, slots=slots,
+                               names=[driver.name], time_dependent=True, what="coordinate driver")

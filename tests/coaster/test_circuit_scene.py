@@ -1,0 +1,37 @@
+"""The ``coaster-circuit`` scene end to end (fast mode): files written, the main run completes the
+circuit, energy conserved on the free-running section, the lossy run's outcome reported, rank 71."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+
+from coaster.scenes import circuit_scene, coaster_scenes
+from core.scenes import run_scene
+
+
+@pytest.fixture(scope="module")
+def out(tmp_path_factory):
+    d = tmp_path_factory.mktemp("scene")
+    run_scene(circuit_scene(), d, fast=True)
+    return d / "coaster-circuit"
+
+
+def test_registered():
+    assert [s.name for s in coaster_scenes()] == ["coaster-analytic", "coaster-circuit"]
+
+
+def test_circuit_scene_outputs(out):
+    for f in ("runs.csv", "energy_drift.csv", "section_peaks.csv", "time_above_limits.csv", "wheel_forces.csv",
+              "rider_loads.csv", "speed.csv", "circuit_3d.png", "speed.png", "wheel_forces.png", "README.md"):
+        assert (out / f).is_file(), f
+    runs = pd.read_csv(out / "runs.csv")
+    assert runs["status"].iloc[0] == "finished", runs["message"].iloc[0]
+    assert runs["status"].iloc[1] in ("finished", "rolled back")
+    if runs["status"].iloc[1] == "rolled back":
+        assert "rolls back" in runs["message"].iloc[1]
+    assert pd.read_csv(out / "energy_drift.csv")["max|E - E0| / T_peak"].iloc[0] < 1e-6
+    rank = pd.read_csv(out / "rank_along_circuit.csv")
+    assert rank["rank min"].iloc[0] == 71 and rank["rank max"].iloc[0] == 71
+    peaks = pd.read_csv(out / "section_peaks.csv")
+    assert {"Lift", "Outbound", "Launch", "Brake"} <= set(peaks["section"])

@@ -155,11 +155,30 @@ def timed_cases():
     return pd.DataFrame(rows)
 
 
+def write_test_states(path=None, rows=range(8, 51)):
+    """States of the curving run (FASTSIM, 10 m/s, 5 outputs per s to t = 12.5 s) for
+    tests/railway/test_wheel_rail.py::test_curving_forces_are_the_same_fresh_and_after_any_history."""
+    from railway.vehicle_scenes import run_curving
+
+    path = Path(path or Path(__file__).resolve().parents[1] / "tests" / "railway" / "curving_states_fastsim_10ms.npz")
+    res, _ = run_curving("fastsim", 10.0, T=12.5, n_output_per_s=5)
+    assert res.success, res.message
+    idx = np.array(list(rows))
+    np.savez_compressed(path, t=np.asarray(res.t)[idx], q=np.asarray(res.q)[idx], v=np.asarray(res.v)[idx])
+    return path
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="two tolerances per method")
+    ap.add_argument("--write-test-states", action="store_true",
+                    help="only write the curving states of the history test (tests/railway)")
     args = ap.parse_args(argv)
     from core.results import markdown_table
+
+    if args.write_test_states:
+        print(write_test_states())
+        return 0
 
     RESULTS.mkdir(exist_ok=True)
     load0 = os.getloadavg()[0]

@@ -80,6 +80,10 @@ TREAD, FLANGE = 0, 1
 _I1, _I2 = np.array([1, 2, 0]), np.array([2, 0, 1])
 
 
+#: two solutions closer than this on the wheel profile (m) are one stationary point
+_SAME_POINT = 1e-4
+
+
 def _cross(a, b):
     """Cross product of (..., 3) arrays (cheaper than np.cross for small arrays)."""
     return a[..., _I1] * b[..., _I2] - a[..., _I2] * b[..., _I1]
@@ -1127,7 +1131,8 @@ class ContactSearch:
 
     def _secondary(self, res, problem, xk, Hk, ck, gk, gsv, separation):
         """A second contact patch per candidate: the lowest *penetrating* pair solution whose wheel
-        profile coordinate differs from the primary contact's by more than ``separation`` (m);
+        profile coordinate differs from the primary contact's by more than ``separation`` (m) and
+        that is not the other zone's primary contact of the same wheel (closer than 0.1 mm to it);
         a ContactResult like ``res`` (invalid where there is none)."""
         pc = self._problems
         P = pc["ws"].size
@@ -1138,6 +1143,9 @@ class ContactSearch:
         info2 = dict(gap=np.full(P, np.inf), S=np.full((P, 11), np.nan), V=np.full((P, 3, 3), np.nan))
         if problem.size:
             far = res.valid.ravel()[problem] & (np.abs(xk[:, 1] - y1[problem]) > separation)
+            # not the other zone's contact of the same wheel (the zones overlap at the split)
+            other = problem ^ 1
+            far &= ~(res.valid.ravel()[other] & (np.abs(xk[:, 1] - y1[other]) < _SAME_POINT))
             g = np.where(far & (gk < 0.0), gk, np.inf)
             order = np.lexsort((np.arange(problem.size), g, problem))
             first = order[np.r_[True, problem[order][1:] != problem[order][:-1]]]

@@ -588,6 +588,8 @@ def _run_curving(ctx):
                               f"{float(w[w['Q [N]'] <= 0]['s [m]'].iloc[0]):.1f} m, "
                               f"{int((w['Q [N]'] <= 0).sum())} of {len(w)} outputs)")
     c = CURVE
+    nq = eq[~eq["quasi-static"].astype(bool)] if len(eq) and "quasi-static" in eq else eq.iloc[0:0]
+    not_qs = ", ".join(f"{r['creep law']} at {r['speed [m/s]']:g} m/s" for _, r in nq.iterrows()) or "none"
     notes = (
         f"The Manchester benchmark coach (data/railway/vehicles/manchester_coach.toml; stand-in for the "
         f"ML95 metro trailer of Pombo & Ambrosio, whose data are not public) through a left curve of "
@@ -605,11 +607,9 @@ def _run_curving(ctx):
         f"lifts) the wheels in the paper's Kalker-linear results; the saturating laws keep Y/Q of the "
         f"inner wheel near mu. Flange contact flag: contact angle above 45 deg. A row of the lateral "
         f"equilibrium table is 'quasi-static' when the standard deviation of the rail forces over the "
-        f"window is below 5 % of m (a_c - g) . n; where it is not (20 m/s with the SHE, Polach 2000 "
-        f"and FASTSIM laws), a wheelset chatters on a contact jump of the S1002 tread: near-conformal "
-        f"tread points modelled as single Hertz ellipses (lateral semi-axes up to ~0.2 m) take large "
-        f"forces from small penetrations, and the means of such impulsive forces sampled at the "
-        f"outputs do not balance; those rows are not results to quote (README, Railway vehicles)."
+        f"window is below 5 % of m (a_c - g) . n; rows that are not: {not_qs}. There a wheelset keeps "
+        f"moving on a contact jump of the S1002 tread and the means over the outputs are not a steady "
+        f"state; such rows are not results to quote (README, Railway vehicles)."
         f"\n\nReferences: Pombo & "
         f"Ambrosio (2008), Multibody Syst. Dyn. 19:91-114 (curving of the ML95 trailer, not available "
         f"here); Nadal (1908); Wickens (2003), ch. 7.")

@@ -73,10 +73,34 @@ the Newton tolerance of the search, as long as the history leaves the two lowest
 the gap in the two tracked points; a contact *jump* between these two minima within a step is
 found because both are iterated at every evaluation.  At each accepted step the tracked points
 are refreshed by a global scan of the cross-section (every ``reseed_every`` accepted steps,
-default 1, and whenever a tracked contact is lost), which is what finds a new minimum.
+default 1, and whenever a tracked contact is lost), which is what finds a new minimum, and by
+Newton from seeds beside every penetrating contact (below, "Nearby minima").  A fresh search at a
+stored state (:meth:`~WheelRailKind.reset_state`) runs the same accepted-step search, so it and
+the state tracked along a run hold the same points (``test_curving_forces_are_the_same_fresh_and_
+after_any_history``: 43 curving states, histories from 0.2 to 1 s earlier, forces equal to 1e-6).
+Where the scan sees no sign change at all at a contact the run already holds (a flange contact
+of a yawed wheelset in a transition), the tracked search keeps it and a fresh one misses it: 2 of
+63 outputs of a curving run at 10 m/s (README, Railway vehicles).
 
-Two patches per zone
---------------------
+Nearby minima
+-------------
+The flange flank over the gauge corner is nearly conformal: the gap across the profile is a flat
+valley that can hold two minima a fraction of a millimetre apart (measured: 0.34 mm apart, gaps
+−10.06 and −7.99 µm, in the Manchester coach's curving at 10 m/s), closer than the scan's grid
+(64 points per zone) resolves.  Which of the two the search held decided the wheel's flange load
+(2.6 kN against 11.6 kN) and so made a fresh search at a stored state disagree with the run by up
+to 35 kN of lateral force on the vehicle.  After every accepted step Newton therefore also starts
+``NEIGHBOUR_OFFSETS`` (±0.5, ±1.5 mm) beside every penetrating contact, so the lower minimum is
+found from either one.  The same holds for two tread minima 11 mm apart with a maximum between
+them: the scan's sign changes are ranked by their interpolated gap, so the maximum can rank second
+and hide the second minimum (``ACCEPT_RANKS`` = 4 refines four), and Newton from a scan seed next to
+the maximum ends on it (refused, B < 0): neighbour seeds start beside every refused scan seed as
+well.  Where a minimum and a maximum fall into one grid interval no sign changes at all; the
+zone's lowest sampled point is then a seed too.  The second tracked point and the second patch of
+a zone are never the other zone's contact of the same wheel (the zones overlap at the split).
+
+Two patches per zone, and the patch set of a wheel
+--------------------------------------------------
 Each candidate zone (tread, flange) may hold two penetrating local minima of the gap at once,
 e.g. where the S1002 tread and flange root both touch the rail near a contact jump.  Picking only
 the lowest makes the force jump when the two minima exchange places; instead the lowest
@@ -102,6 +126,15 @@ the results depend on where the steps fall.  The shares are a modelling choice o
 between the deepest-point and the two-patch models, not a result of contact theory (CONTACT,
 for comparison, combines patches closer than a distance and separates the others).  Wheel totals
 (Q, Y, Tγ) include both patches; the per-candidate outputs are the primary patch's.
+
+The two zones overlap by 1 mm at the split, so one stationary point can be found by both: as the
+flange zone's primary and as the tread zone's second patch.  The wheel's patches (tread and
+flange, primary and second) are therefore taken together: a patch at the point of an earlier
+loaded one (closer than ``DUPLICATE`` = 0.1 mm) carries nothing, so a point is never loaded
+twice (:func:`patch_shares`; before, the flange contact was counted twice whenever the tread
+zone's second tracked point had found it).  Patches of different zones do not share load (the
+tread and the flange root are a two-point contact); sharing them as well made the lateral force
+swing with µm of gap at the flange root and the run rattle.
 
 Jacobians
 ---------
@@ -180,6 +213,16 @@ FD_POSE, FD_VELOCITY = 1e-7, 1e-6
 SEPARATION = 3e-3
 #: gap difference (m) over which two overlapping patches hand the load over (module docstring)
 BLEND_GAP = 1e-5
+#: two patches of a wheel closer than this (m) on the wheel profile are one stationary point found
+#: from both zones (module docstring, "The patch set of a wheel")
+DUPLICATE = 1e-4
+#: offsets (m) on the wheel profile of the extra seeds beside every penetrating contact after an
+#: accepted step (module docstring, "Nearby minima")
+NEIGHBOUR_OFFSETS = (-1.5e-3, -0.5e-3, 0.5e-3, 1.5e-3)
+#: stationary points of the cross-section scan refined after an accepted step, per candidate: the
+#: four lowest sign changes (two minima of the S1002 tread may have the maximum between them as
+#: the second lowest)
+ACCEPT_RANKS = 4
 
 
 @dataclass(frozen=True, eq=False)
@@ -400,22 +443,38 @@ class _Set:
 
     def accept_pairs(self, r, Ans, s, reseed, robust=None):
         """The accepted step's search: both tracked points of the candidates that had a contact
-        and, when re-seeding, the two best scan seeds of every candidate where the scan found a
-        stationary point near (a sign change of the fourth condition); returns (res, X, G,
-        problem) with the Newton solution and gap of every pair."""
+        and, when re-seeding, the best scan seeds of every candidate (``ACCEPT_RANKS`` sign
+        changes of the fourth condition, and the zone's lowest sampled point), then seeds beside
+        every penetrating contact and every scan seed whose Newton iteration was refused
+        (:func:`neighbour_seeds`); returns (res, X, G, problem) with the Newton solution and gap
+        of every pair."""
         x0, prob = self.pairs(s)
+        scan_seed = np.zeros(prob.size, bool)
         if reseed:
-            scan = self.cs.scan_seeds(r, Ans, s, ranks=2)
-            extra = [(q[q[:, 4] > 0.5, :4], np.flatnonzero(q[:, 4] > 0.5)) for q in scan]
+            scan = self.cs.scan_seeds(r, Ans, s, ranks=ACCEPT_RANKS)
+            extra = [(q[q[:, 4] > 0.5, :4], np.flatnonzero(q[:, 4] > 0.5), True) for q in scan]
+            # the zone's lowest sampled point also where the scan saw no sign change: a minimum
+            # and a maximum of the gap within one grid interval (a flat valley) change no sign
+            nf = scan[0][:, 4] <= 0.5
+            extra.append((scan[0][nf, :4], np.flatnonzero(nf), False))
             # a candidate where the scan found a stationary point is refined robustly as well
             # when Newton fails there (e.g. a flange touching the rail after a lift-off)
             flagged = np.any([q[:, 4] > 0.5 for q in scan], axis=0)
             robust = flagged if robust is None else (np.asarray(robust, bool) | flagged)
-            x0 = np.concatenate([x0] + [a for a, _ in extra])
-            prob = np.concatenate([prob] + [b for _, b in extra])
+            x0 = np.concatenate([x0] + [a for a, _, _ in extra])
+            prob = np.concatenate([prob] + [b for _, b, _ in extra])
+            scan_seed = np.concatenate([scan_seed] + [np.full(b.size, f) for _, b, f in extra])
+            order = np.argsort(prob, kind="stable")
+            x0, prob, scan_seed = x0[order], prob[order], scan_seed[order]
+        res, X, G = self.cs.solve_pairs(x0, prob, r, Ans, s, robust=robust, secondary=SEPARATION)
+        refused = scan_seed & ~np.isfinite(G)
+        xn, pn = neighbour_seeds(res, x0[refused], prob[refused])
+        if pn.size:  # a lower minimum of the gap next to a contact (module docstring)
+            x0 = np.concatenate([x0, xn])
+            prob = np.concatenate([prob, pn])
             order = np.argsort(prob, kind="stable")
             x0, prob = x0[order], prob[order]
-        res, X, G = self.cs.solve_pairs(x0, prob, r, Ans, s, robust=robust, secondary=SEPARATION)
+            res, X, G = self.cs.solve_pairs(x0, prob, r, Ans, s, robust=robust, secondary=SEPARATION)
         return res, X, G, prob
 
     def predicted_seeds(self, s):
@@ -472,12 +531,15 @@ class _Set:
             f["secondary"] = zero
             return f
         f2 = self.cf(res2, r, Ans, v, w)
-        s1, s2 = patch_shares(res.y_wheel, res2.y_wheel, res.gap, res2.gap, f["b"], f2["b"], f2["N"] > 0)
-        for ff, sh in ((f, s1), (f2, s2)):
+        # the wheel's patches: (tread, flange) primary then (tread, flange) second
+        stack = lambda a1, a2: np.concatenate([a1, a2], axis=-1)
+        sh = patch_shares(stack(res.y_wheel, res2.y_wheel), stack(res.gap, res2.gap), stack(f["b"], f2["b"]),
+                          stack(res.valid & (f["N"] > 0), res2.valid & (f2["N"] > 0)))
+        for ff, shk in ((f, sh[:, :2]), (f2, sh[:, 2:])):
             for k in ("N", "Fx", "Fy", "Mz"):
-                ff[k] = ff[k] * sh
-            ff["force"] = ff["force"] * sh[..., None]
-            ff["moment"] = ff["moment"] * sh[..., None]
+                ff[k] = ff[k] * shk
+            ff["force"] = ff["force"] * shk[..., None]
+            ff["moment"] = ff["moment"] * shk[..., None]
         f["secondary"] = f2
         return f
 
@@ -584,8 +646,16 @@ class WheelRailKind(ForceKind):
         Ans = st.unspun(A, s)
         scan = st.cs.scan_seeds(r, Ans, s, ranks=4)
         res, X, G, xb = st.cs.solve([q[:, :4] for q in scan], r, Ans, s, scan_out=scan)
-        return _State(seeds=_two_lowest(xb, X, G), s_ws=s, valid=res.valid.ravel().copy(),
-                      accepted=0, last_YQ=np.full(2 * st.n_ws, np.nan))
+        state = _State(seeds=_two_lowest(xb, X, G), s_ws=s, valid=res.valid.ravel().copy(),
+                       accepted=0, last_YQ=np.full(2 * st.n_ws, np.nan))
+        # the accepted-step search from these points: the neighbours of every contact are
+        # probed there, as after every accepted step of a run
+        st.state = state
+        res, X, G, prob = st.accept_pairs(r, Ans, s, True, robust=state.valid)
+        xb = np.column_stack([res.theta.ravel(), res.y_wheel.ravel(), res.s_rail.ravel(), res.u_rail.ravel()])
+        state.seeds = _two_lowest_pairs(xb, res.valid.ravel(), X, G, prob, state.seeds)
+        state.valid = res.valid.ravel().copy()
+        return state
 
     def reset_state(self, bs, t):
         for st in self.sets:
@@ -665,19 +735,63 @@ class WheelRailKind(ForceKind):
 
 
 # ------------------------------------------------------------------------------------------
-def patch_shares(y1, y2, g1, g2, b1, b2, second):
-    """Shares (s1, s2) of the primary and second patches' forces (module docstring)."""
+def patch_shares(y, g, b, loaded):
+    """Shares of every patch of a wheel (module docstring, "The patch set of a wheel").
+
+    Parameters: arrays (..., m) over the m patches of each wheel (tread and flange candidates'
+    primary and second patches, in that order): wheel profile coordinate y (m), gap g (m), lateral
+    semi-axis b (m), ``loaded`` (valid and penetrating).  A patch at the point of an earlier loaded
+    patch (|Δy| < ``DUPLICATE``: the same stationary point found from both zones) has share 0;
+    every other loaded patch i gets s_i = Π_j [w_ij + (1 − w_ij) σ(g_j − g_i)] over the other
+    loaded, distinct patches j.  Returns the shares (..., m) (1 where not loaded).
+    """
+    y, g, b = (np.asarray(a, float) for a in (y, g, b))
+    loaded = np.asarray(loaded, bool) & np.isfinite(y) & np.isfinite(g)
+    m = y.shape[-1]
+    dup = np.zeros_like(loaded)
+    for i in range(1, m):
+        for j in range(i):
+            dup[..., i] |= loaded[..., j] & ~dup[..., j] & (np.abs(y[..., i] - y[..., j]) < DUPLICATE)
+    live = loaded & ~dup
+    share = np.where(dup, 0.0, 1.0)
     with np.errstate(invalid="ignore", over="ignore"):
-        d = np.abs(y2 - y1)
-        bsum = b1 + b2
-        w = np.clip((d - bsum) / (0.5 * np.where(bsum > 0, bsum, 1.0)), 0.0, 1.0)
-        sig = 0.5 * (1.0 + np.tanh((g2 - g1) / BLEND_GAP))
-    ok = second & np.isfinite(d) & np.isfinite(g2)
-    w = np.where(ok, w, 0.0)
-    sig = np.where(ok, sig, 1.0)
-    s1 = np.where(ok, w + (1.0 - w) * sig, 1.0)
-    s2 = np.where(ok, w + (1.0 - w) * (1.0 - sig), 0.0)
-    return s1, s2
+        for i in range(m):
+            for j in range(m):
+                if i == j or i % 2 != j % 2:  # patches of the same zone share
+                    continue
+                both = live[..., i] & live[..., j]
+                bsum = b[..., i] + b[..., j]
+                w = np.clip((np.abs(y[..., j] - y[..., i]) - bsum) / (0.5 * np.where(bsum > 0, bsum, 1.0)), 0.0, 1.0)
+                sig = 0.5 * (1.0 + np.tanh((g[..., j] - g[..., i]) / BLEND_GAP))
+                share[..., i] *= np.where(both, w + (1.0 - w) * sig, 1.0)
+    return share
+
+
+def neighbour_seeds(res, x_refused=None, p_refused=None):
+    """Seeds ``NEIGHBOUR_OFFSETS`` beside every penetrating contact on the wheel profile (the rail
+    coordinate moved alike) and beside every scan seed ``x_refused`` (problems ``p_refused``) whose
+    Newton iteration was refused: (x0 (K, 4), problem (K,)).  A flat valley of the gap (the flange
+    flank over the gauge corner, the S1002 tread near 6 mm) can hold two minima and a maximum
+    within a fraction of a millimetre to a few millimetres, closer than the scan's grid resolves:
+    Newton from a scan seed may end on the maximum (refused, B < 0), and from a tracked minimum
+    stays there; Newton from both sides finds the other minimum whichever the search held."""
+    valid = res.valid.ravel()
+    xb = np.column_stack([res.theta.ravel(), res.y_wheel.ravel(), res.s_rail.ravel(), res.u_rail.ravel()])
+    idx = np.flatnonzero(valid & (res.gap.ravel() < 0.0))
+    centre, prob = xb[idx], idx
+    if x_refused is not None and len(p_refused):
+        centre = np.concatenate([centre, x_refused])
+        prob = np.concatenate([prob, p_refused])
+    if not prob.size:
+        return np.zeros((0, 4)), np.zeros(0, np.int64)
+    xs, ps = [], []
+    for d in NEIGHBOUR_OFFSETS:
+        xn = centre.copy()
+        xn[:, 1] += d
+        xn[:, 3] += d
+        xs.append(xn)
+        ps.append(prob)
+    return np.concatenate(xs), np.concatenate(ps).astype(np.int64)
 
 
 def _two_lowest_pairs(xb, valid, X, G, prob, old, distinct=1e-4):
@@ -688,6 +802,10 @@ def _two_lowest_pairs(xb, valid, X, G, prob, old, distinct=1e-4):
     first = np.where(valid[:, None], xb, old[0])
     second = first.copy()
     far = np.abs(X[:, 1] - xb[prob, 1]) > distinct
+    # not the other zone's contact of the same wheel (the zones overlap at the split): the next
+    # stationary point is tracked instead, as a fresh search tracks it
+    other = prob ^ 1
+    far &= ~(valid[other] & (np.abs(X[:, 1] - xb[other, 1]) < DUPLICATE))
     g = np.where(far & np.isfinite(G), G, np.inf)
     if g.size:
         order = np.lexsort((np.arange(g.size), g, prob))

@@ -51,7 +51,7 @@ from core.compiled.protocol import (
 
 from ._kernels import newton, ppeval, reduced_min, scan
 from .forces import kernel as contact_forces
-from .wheel_rail import BLEND_GAP, SEPARATION, climb_message
+from .wheel_rail import ACCEPT_RANKS, BLEND_GAP, DUPLICATE, NEIGHBOUR_OFFSETS, SEPARATION, climb_message
 
 __all__ = ["compile_wheel_rail", "describe_failure"]
 
@@ -277,7 +277,9 @@ def _second(xb, valid, X, Ga, Sp, Vp, prob, sep):
     best = np.full(P, -1, dtype=np.int64)
     for i in range(prob.shape[0]):
         p = prob[i]
-        if valid[p] and Ga[i] < 0.0 and abs(X[i, 1] - xb[p, 1]) > sep and Ga[i] < gap2[p]:
+        q = p ^ 1  # the other zone of the same wheel: its contact is not this zone's second
+        same = valid[q] and abs(X[i, 1] - xb[q, 1]) < DUPLICATE
+        if valid[p] and Ga[i] < 0.0 and abs(X[i, 1] - xb[p, 1]) > sep and Ga[i] < gap2[p] and not same:
             gap2[p] = Ga[i]
             best[p] = i
     for p in range(P):
@@ -294,34 +296,51 @@ def _second(xb, valid, X, Ga, Sp, Vp, prob, sep):
 
 
 @_jit
-def _weigh_second(Sb, gb, out, Fg, Mg, P):
-    """Shares of the primary and second patches (railway.wheel_rail.patch_shares)."""
-    for p in range(P):
-        q = P + p
-        if not (out[q, 0] > 0.0):
-            continue
-        d = abs(Sb[q, 1] - Sb[p, 1])
-        if not (np.isfinite(d) and np.isfinite(gb[q])):
+def _weigh_patches(vb, Sb, gb, out, Fg, Mg, P):
+    """Shares of every wheel's patches (railway.wheel_rail.patch_shares): per wheel the patches
+    (tread, flange) primary and second, duplicates of an earlier loaded patch dropped, the
+    others weighted by the product over their overlapping neighbours of the same zone."""
+    idx = np.empty(4, dtype=np.int64)
+    loaded = np.empty(4, dtype=np.bool_)
+    dup = np.empty(4, dtype=np.bool_)
+    share = np.empty(4)
+    for wi in range(P // 2):
+        idx[0], idx[1], idx[2], idx[3] = 2 * wi, 2 * wi + 1, P + 2 * wi, P + 2 * wi + 1
+        for i in range(4):
+            p = idx[i]
+            loaded[i] = vb[p] and out[p, 0] > 0.0 and np.isfinite(Sb[p, 1]) and np.isfinite(gb[p])
+            dup[i] = False
+            share[i] = 1.0
+        for i in range(1, 4):
+            for j in range(i):
+                if (loaded[i] and loaded[j] and not dup[j]
+                        and abs(Sb[idx[i], 1] - Sb[idx[j], 1]) < DUPLICATE):
+                    dup[i] = True
+        for i in range(4):
+            if dup[i]:
+                share[i] = 0.0
+                continue
+            if not loaded[i]:
+                continue
+            pi = idx[i]
+            for j in range(4):
+                if j == i or j % 2 != i % 2 or not loaded[j] or dup[j]:
+                    continue  # patches of the same zone share
+                pj = idx[j]
+                bsum = out[pi, 8] + out[pj, 8]
+                w = (abs(Sb[pj, 1] - Sb[pi, 1]) - bsum) / (0.5 * (bsum if bsum > 0.0 else 1.0))
+                w = min(max(w, 0.0), 1.0)
+                sig = 0.5 * (1.0 + np.tanh((gb[pj] - gb[pi]) / BLEND_GAP))
+                share[i] *= w + (1.0 - w) * sig
+        for i in range(4):
+            if share[i] == 1.0:
+                continue
+            p = idx[i]
             for k in range(4):
-                out[q, k] = 0.0
+                out[p, k] *= share[i]
             for k in range(3):
-                Fg[q, k] = 0.0
-                Mg[q, k] = 0.0
-            continue
-        bsum = out[p, 8] + out[q, 8]
-        w = (d - bsum) / (0.5 * (bsum if bsum > 0.0 else 1.0))
-        w = min(max(w, 0.0), 1.0)
-        sig = 0.5 * (1.0 + np.tanh((gb[q] - gb[p]) / BLEND_GAP))
-        s1 = w + (1.0 - w) * sig
-        s2 = w + (1.0 - w) * (1.0 - sig)
-        for k in range(4):
-            out[p, k] *= s1
-            out[q, k] *= s2
-        for k in range(3):
-            Fg[p, k] *= s1
-            Mg[p, k] *= s1
-            Fg[q, k] *= s2
-            Mg[q, k] *= s2
+                Fg[p, k] *= share[i]
+                Mg[p, k] *= share[i]
 
 
 @_jit
@@ -568,7 +587,7 @@ def wheel_rail_forces(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
                 gap2[p] = np.inf
         vb, gb, Sb, Vb = _both(valid, gap, S, V, valid2, gap2, S2, V2)
         out, Fg, Mg, vmin = _forces(fd, ix, e, vb, gb, Sb, Vb, rws, vws, wws, Ans)
-        _weigh_second(Sb, gb, out, Fg, Mg, P)
+        _weigh_patches(vb, Sb, gb, out, Fg, Mg, P)
         if ix[e, IX_MODEL] >= 0 and vmin < 1e-3:
             err[1] = e
             return ELEMENT_FAILED
@@ -597,8 +616,8 @@ def wheel_rail_forces(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
 
 
 @_jit
-def _scan_seeds(fd, ix, e, rws, Ans, s, o):
-    """The global scan's two best stationary points per problem: (2, P, 7)."""
+def _scan_seeds(fd, ix, e, rws, Ans, s, o, n_rank=2):
+    """The global scan's ``n_rank`` best stationary points per problem: (n_rank, P, 7)."""
     n_ws = ix[e, IX_NWS]
     P = 4 * n_ws
     G = ix[e, IX_G]
@@ -637,13 +656,13 @@ def _scan_seeds(fd, ix, e, rws, Ans, s, o):
             s0[p] = s[k]
     rl = _seg2(fd, ix, e, K_RAIL_L)
     rr = _seg2(fd, ix, e, K_RAIL_R)
-    out = np.empty((2, P, 7))
+    out = np.empty((n_rank, P, 7))
     side_left = np.empty(P, dtype=np.bool_)
     for p in range(P):
         side_left[p] = sig[p] > 0
     scan(rP, ax, d, pos, tan, lat, up, sig, sc[SC_LW], _seg2(fd, ix, e, K_YG), _seg2(fd, ix, e, K_RG),
          _seg2(fd, ix, e, K_F1G), side_left, rl[0], rl[1], rl[2], rl[3], rr[0], rr[1], rr[2], rr[3],
-         _seg1(fd, ix, e, K_ULO), _seg1(fd, ix, e, K_UHI), theta, s0, 2, out)
+         _seg1(fd, ix, e, K_ULO), _seg1(fd, ix, e, K_UHI), theta, s0, n_rank, out)
     return out
 
 
@@ -653,21 +672,22 @@ def _accept_pairs(fd, ix, e, seeds, s, s_prev, val_prev, rws, Ans, reseed, o):
     distinct) and, when re-seeding, the flagged scan seeds; sorted by problem (tracked first)."""
     n_ws = ix[e, IX_NWS]
     P = 4 * n_ws
-    sd = _scan_seeds(fd, ix, e, rws, Ans, s, o) if reseed else np.zeros((2, P, 7))
+    sd = _scan_seeds(fd, ix, e, rws, Ans, s, o, ACCEPT_RANKS) if reseed else np.zeros((ACCEPT_RANKS, P, 7))
     K = 0
     for p in range(P):
         if val_prev[p] > 0.5:
             K += 2 if abs(seeds[1, p, 1] - seeds[0, p, 1]) > 1e-9 else 1
-        for j in range(2):
-            if sd[j, p, 4] > 0.5:
+        for j in range(ACCEPT_RANKS):
+            if sd[j, p, 4] > 0.5 or (reseed and j == 0):
                 K += 1
     x0 = np.empty((K, 4))
     prob = np.empty(K, dtype=np.int64)
+    from_scan = np.zeros(K, dtype=np.bool_)
     i = 0
     for p in range(P):
         ds = s[p // 4] - s_prev[p // 4]
         if val_prev[p] > 0.5:
-            for j in range(2):
+            for j in range(2):  # the two tracked points
                 if j == 1 and not abs(seeds[1, p, 1] - seeds[0, p, 1]) > 1e-9:
                     continue
                 for c in range(4):
@@ -675,16 +695,68 @@ def _accept_pairs(fd, ix, e, seeds, s, s_prev, val_prev, rws, Ans, reseed, o):
                 x0[i, 2] += ds
                 prob[i] = p
                 i += 1
-        for j in range(2):
-            if sd[j, p, 4] > 0.5:
+        for j in range(ACCEPT_RANKS):
+            # the zone's lowest sampled point also without a sign change (a minimum and a
+            # maximum of the gap within one grid interval; railway.wheel_rail.accept_pairs)
+            if sd[j, p, 4] > 0.5 or (reseed and j == 0):
                 for c in range(4):
                     x0[i, c] = sd[j, p, c]
                 prob[i] = p
+                from_scan[i] = sd[j, p, 4] > 0.5
                 i += 1
     flagged = np.zeros(P, dtype=np.bool_)
     for p in range(P):
-        flagged[p] = sd[0, p, 4] > 0.5 or sd[1, p, 4] > 0.5
-    return x0, prob, flagged
+        for j in range(ACCEPT_RANKS):
+            if sd[j, p, 4] > 0.5:
+                flagged[p] = True
+    return x0, prob, flagged, from_scan
+
+
+@_jit
+def _with_neighbours(x0, prob, xb, valid, gap, from_scan, Ga):
+    """(x1, prob1, n_new): the pairs x0 with NEIGHBOUR_OFFSETS seeds beside every penetrating
+    contact and beside every flagged scan seed whose Newton iteration was refused (Ga = inf)
+    (railway.wheel_rail.neighbour_seeds), sorted by problem (stable: existing pairs first)."""
+    P = valid.shape[0]
+    K = prob.shape[0]
+    no = len(NEIGHBOUR_OFFSETS)
+    n_new = 0
+    for p in range(P):
+        if valid[p] and gap[p] < 0.0:
+            n_new += no
+    for i in range(K):
+        if from_scan[i] and not np.isfinite(Ga[i]):
+            n_new += no
+    x1 = np.empty((K + n_new, 4))
+    prob1 = np.empty(K + n_new, dtype=np.int64)
+    i = 0
+    i_old = 0
+    for p in range(P):
+        k0 = i_old
+        while i_old < K and prob[i_old] == p:
+            for c in range(4):
+                x1[i, c] = x0[i_old, c]
+            prob1[i] = p
+            i += 1
+            i_old += 1
+        if valid[p] and gap[p] < 0.0:
+            for j in range(no):
+                for c in range(4):
+                    x1[i, c] = xb[p, c]
+                x1[i, 1] += NEIGHBOUR_OFFSETS[j]
+                x1[i, 3] += NEIGHBOUR_OFFSETS[j]
+                prob1[i] = p
+                i += 1
+        for k in range(k0, i_old):
+            if from_scan[k] and not np.isfinite(Ga[k]):
+                for j in range(no):
+                    for c in range(4):
+                        x1[i, c] = x0[k, c]
+                    x1[i, 1] += NEIGHBOUR_OFFSETS[j]
+                    x1[i, 3] += NEIGHBOUR_OFFSETS[j]
+                    prob1[i] = p
+                    i += 1
+    return x1, prob1, n_new
 
 
 @accept_kernel
@@ -710,7 +782,7 @@ def wheel_rail_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
                 return ELEMENT_FAILED
         reseed = (int(row[ST_ACC]) + 1) % ix[e, IX_RESEED] == 0
         while True:
-            x0, prob, flagged = _accept_pairs(fd, ix, e, seeds, s, s_prev, val_prev, rws, Ans, reseed, o)
+            x0, prob, flagged, from_scan = _accept_pairs(fd, ix, e, seeds, s, s_prev, val_prev, rws, Ans, reseed, o)
             xb, valid, gap, S, V, X, Gm, Sp, Vp = _solve(fd, ix, e, rws, Ans, x0, prob)
             if reseed:
                 prevm = np.zeros(P, dtype=np.bool_)
@@ -724,10 +796,20 @@ def wheel_rail_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
             if not lost_any or reseed:
                 break
             reseed = True
+        # seeds beside every penetrating contact (railway.wheel_rail.neighbour_seeds)
+        x1, prob1, n_new = _with_neighbours(x0, prob, xb, valid, gap, from_scan, Gm)
+        if n_new > 0:
+            x0, prob = x1, prob1
+            xb, valid, gap, S, V, X, Gm, Sp, Vp = _solve(fd, ix, e, rws, Ans, x0, prob)
+            if reseed:
+                prevm = np.zeros(P, dtype=np.bool_)
+                for p in range(P):
+                    prevm[p] = val_prev[p] > 0.5 or flagged[p]
+                _robust_merge(fd, ix, e, rws, Ans, xb, valid, gap, S, V, prevm)
         valid2, gap2, S2, V2 = _second(xb, valid, X, Gm, Sp, Vp, prob, SEPARATION)
         vb, gb, Sb, Vb = _both(valid, gap, S, V, valid2, gap2, S2, V2)
         out, Fg, Mg, vmin = _forces(fd, ix, e, vb, gb, Sb, Vb, rws, vws, wws, Ans)
-        _weigh_second(Sb, gb, out, Fg, Mg, P)
+        _weigh_patches(vb, Sb, gb, out, Fg, Mg, P)
         # per wheel: Y/Q (module docstring of railway.wheel_rail), the highest penetrating
         # contact on the flange (lowest y_wheel); per wheelset: lateral displacement and drop.
         # The checks in the numpy kind's order: flange climb first, then a wheelset that left
@@ -787,6 +869,9 @@ def wheel_rail_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
             jbest, gbest = -1, np.inf
             for i in range(K):
                 if prob[i] == p and abs(X[i, 1] - xb[p, 1]) > 1e-4 and np.isfinite(Gm[i]) and Gm[i] < gbest:
+                    q_ = p ^ 1  # not the other zone's contact (railway.wheel_rail._two_lowest_pairs)
+                    if valid[q_] and abs(X[i, 1] - xb[q_, 1]) < DUPLICATE:
+                        continue
                     gbest, jbest = Gm[i], i
             for c in range(4):
                 seeds[0, p, c] = xb[p, c]

@@ -321,3 +321,68 @@ def test_a_vehicle_file_with_yaw_dampers_builds_settles_and_runs(tmp_path):
     q0, v0 = veh.initial_state(wheelset_lateral=[0.002, 0, 0, 0])
     res = simulate(veh.model, (0.0, 0.2), "jit-radau", q0=q0, v0=v0, rtol=1e-4, atol=1e-6)
     assert res.success, res.message
+
+
+# ---------------------------------------------------------------------------------------------
+# the patch set of a wheel: a function of the geometry, not of the search's history
+# ---------------------------------------------------------------------------------------------
+def test_patch_shares_never_load_one_point_twice_and_share_only_within_a_zone():
+    from railway.wheel_rail import BLEND_GAP, patch_shares
+
+    # patches (tread, flange) primary, (tread, flange) second; y [m], gap [m], lateral semi-axis [m]
+    y = np.array([[-0.0322, -0.03812, -0.03812, np.nan]])  # the tread zone's second = the flange's primary
+    g = np.array([[-70e-6, -8e-6, -8e-6, np.inf]])
+    b = np.array([[2.3e-3, 1.0e-3, 1.0e-3, 0.0]])
+    sh = patch_shares(y, g, b, np.array([[True, True, True, False]]))
+    np.testing.assert_array_equal(sh, [[1.0, 1.0, 0.0, 1.0]])  # the duplicate carries nothing,
+    # the tread and the flange (different zones, 5.9 mm apart, overlapping ellipses) both full
+    # two overlapping patches of one zone: shares sum to one, the deeper carries more
+    y = np.array([[0.0036, np.nan, 0.0030, np.nan]])
+    g = np.array([[-40e-6, np.inf, -40e-6 + BLEND_GAP, np.inf]])
+    b = np.array([[8e-3, 0.0, 8e-3, 0.0]])
+    sh = patch_shares(y, g, b, np.array([[True, False, True, False]]))
+    assert sh[0, 0] + sh[0, 2] == pytest.approx(1.0, abs=1e-15)
+    assert sh[0, 0] == pytest.approx(0.5 * (1.0 + np.tanh(1.0)), rel=1e-12)
+    # two separate patches of one zone (11 mm apart, 2 mm semi-axes) both carry their full load
+    y = np.array([[0.0036, np.nan, -0.0075, np.nan]])
+    b = np.array([[2e-3, 0.0, 2e-3, 0.0]])
+    sh = patch_shares(y, g, b, np.array([[True, False, True, False]]))
+    np.testing.assert_array_equal(sh, [[1.0, 1.0, 1.0, 1.0]])
+
+
+CURVING_STATES = Path(__file__).with_name("curving_states_fastsim_10ms.npz")
+
+
+@pytest.mark.skipif(not CURVING_STATES.exists(), reason="state file missing")
+def test_curving_forces_are_the_same_fresh_and_after_any_history():
+    """States of the Manchester coach in the 200 m curve (scene railway-curving, FASTSIM at
+    10 m/s; written by benchmarks/railway_vehicle.py --write-test-states): at each target state the
+    wheel-rail forces from a fresh search equal those after a history that started at another
+    stored state up to 1 s earlier and took one accepted step to the target.  Those states hold
+    the cases that made the forces depend on history: two minima of the flange flank's gap
+    0.3 mm apart, two tread minima 11 mm apart with a maximum between them as the scan's second
+    lowest stationary point, the tread zone finding the flange zone's contact (tolerance: the
+    search's Newton tolerance on the gap, 1e-11 m, times the Hertz stiffness: 1e-6 of the force)."""
+    from railway.vehicle_scenes import creep_law_spec, curving_track
+
+    data = np.load(CURVING_STATES)
+    cl, cp = creep_law_spec("polach2000", 10.0)
+    veh = build_vehicle(VehicleDefinition.manchester(), curving_track(), s0=35.0, speed=10.0, creep_law=cl,
+                        creep_params=cp, speed_control=10.0)
+    m = veh.model
+    kind = kind_of(m)
+    t, q, v = data["t"], data["q"], data["v"]
+    worst = 0.0
+    for i in range(5, len(t)):
+        bs = m.body_states(q[i], v[i])
+        kind.reset_state(bs, float(t[i]))
+        fresh = kind.evaluate(bs, float(t[i])).Qb.copy()
+        for j in (i - 1, i - 3, i - 5):
+            kind.reset_state(m.body_states(q[j], v[j]), float(t[j]))
+            kind.accept_step(bs, float(t[i]), check=False)
+            after = kind.evaluate(bs, float(t[i])).Qb
+            scale = np.abs(fresh).max()
+            worst = max(worst, np.abs(after - fresh).max() / scale)
+            np.testing.assert_allclose(after, fresh, rtol=0, atol=1e-6 * scale,
+                                       err_msg=f"target row {i}, history from row {j}")
+    assert worst < 1e-6

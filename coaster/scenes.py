@@ -130,6 +130,7 @@ def _figures(tr, fr, cl, sec, main, loads, wf):
     from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
     figs = {}
+    run_label = f"{main.meta['method']}, rtol {main.meta['rtol']:g}"
     L = main.L[:, 0]
     tab = main.table()
     # speed and height
@@ -147,7 +148,7 @@ def _figures(tr, fr, cl, sec, main, loads, wf):
     for _, r in sec.iterrows():
         ax1.text(0.5 * (r["L_start [m]"] + r["L_end [m]"]), ax1.get_ylim()[1] * 0.95, r["section"], ha="center",
                  va="top", fontsize=7)
-    ax1.set_title("Three-car train over the circuit: chain lift, free running, booster, brakes")
+    ax1.set_title(f"coaster-circuit: three-car train, chain lift, free running, booster, brakes ({run_label})")
     figs["speed"] = fig
     # wheel forces
     fig = Figure(figsize=(10, 6.5))
@@ -161,7 +162,7 @@ def _figures(tr, fr, cl, sec, main, loads, wf):
     for ax in (ax1, ax2):
         ax.legend()
         ax.grid(alpha=0.3)
-    ax1.set_title("Wheel forces from the path joints' multipliers (track frame, on the wheelset)")
+    ax1.set_title(f"coaster-circuit: wheel forces from the path joints' multipliers, track frame ({run_label})")
     figs["wheel_forces"] = fig
     # load factors
     fig = Figure(figsize=(10, 5))
@@ -170,6 +171,7 @@ def _figures(tr, fr, cl, sec, main, loads, wf):
         ax.plot(loads["L [m]"], loads[c], label=c)
     ax.set_xlabel("arc length L1 [m]")
     ax.set_ylabel("load factor at the rider of car 1 [g]")
+    ax.set_title(f"coaster-circuit: rider load factors in car axes ({run_label})")
     ax.grid(alpha=0.3)
     ax.legend()
     figs["load_factors"] = fig
@@ -190,10 +192,57 @@ def _figures(tr, fr, cl, sec, main, loads, wf):
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m] (×5)")
-    fig.colorbar(lc, ax=ax, shrink=0.6, label="vertical load factor n_z at the rider of car 1 [g]")
-    ax.set_title("Circuit coloured by the vertical rider load factor")
+    fig.colorbar(lc, ax=ax, shrink=0.6, pad=0.12, label="vertical load factor n_z at the rider of car 1 [g]")
+    ax.set_title(f"coaster-circuit: track coloured by the rider's vertical load factor ({run_label})")
     figs["circuit_3d"] = fig
     return figs
+
+
+def _frame_quality(fr, cl, step=1.0):
+    """Frame quality along the circuit (coaster.frames.frame_quality every ``step`` m): the
+    samples with units in the column names, a summary and a figure."""
+    from matplotlib.figure import Figure
+
+    from .frames import frame_quality
+
+    q = frame_quality(fr, cl, L=np.arange(0.0, cl.length, step))
+    q = q.rename(columns={"L_m": "L [m]", "orthonormality": "max |R^T R - I| [-]", "tangent_error": "|t - g'| [-]",
+                          "position_error_m": "|r - g| [m]", "R_jump": "max |R_i - R_i-1| [-]",
+                          "rotation_step_rad": "rotation step [rad]", "expected_step_rad": "|omega| dL [rad]",
+                          "curvature_1_m": "curvature [1/m]", "torsion_1_m": "torsion [1/m]",
+                          "twist_1_m": "twist omega.t [1/m]"})
+    ratio = (q["rotation step [rad]"] / q["|omega| dL [rad]"]).replace([np.inf, -np.inf], np.nan)
+    end = fr.evaluate(np.array([0.0, cl.length]))
+    closure = float(np.max(np.abs(end.R[0] - end.R[1])))
+    summary = pd.DataFrame([{
+        "samples": len(q), "step [m]": step,
+        "max |R^T R - I| [-]": q["max |R^T R - I| [-]"].max(), "max |t - g'| [-]": q["|t - g'| [-]"].max(),
+        "max |r - g| [m]": q["|r - g| [m]"].max(),
+        "max rotation step [rad]": q["rotation step [rad]"].max(),
+        "max rotation step / (|omega| dL) [-]": ratio.max(),
+        "frame closure max |R(length) - R(0)| [-]": closure,
+        "max curvature [1/m]": q["curvature [1/m]"].max(),
+        "max |torsion| [1/m]": q["torsion [1/m]"].abs().max()}])
+    fig = Figure(figsize=(10, 8))
+    ax = fig.subplots(4, 1, sharex=True)
+    L = q["L [m]"]
+    ax[0].plot(L, q["curvature [1/m]"], lw=0.8)
+    ax[0].set_ylabel("curvature [1/m]")
+    ax[1].plot(L, q["torsion [1/m]"], lw=0.8)
+    lim = float(np.nanpercentile(np.abs(q["torsion [1/m]"]), 99)) * 1.5
+    ax[1].set_ylim(-lim, lim)
+    ax[1].set_ylabel("torsion [1/m]\n(99th pct. range)")
+    ax[2].semilogy(L, np.maximum(q["max |R^T R - I| [-]"], 1e-17), lw=0.8)
+    ax[2].set_ylabel("max |R^T R - I| [-]")
+    ax[3].plot(L, q["rotation step [rad]"], lw=0.8, label="rotation between samples")
+    ax[3].plot(L, q["|omega| dL [rad]"], lw=0.8, ls="--", label="|omega| dL")
+    ax[3].set_ylabel("rotation step [rad]")
+    ax[3].set_xlabel("arc length L [m]")
+    ax[3].legend(fontsize=8)
+    ax[0].set_title("coaster-circuit: rotation-minimising frame with bank along the circuit "
+                    f"(quintic spline, samples every {step:g} m; closure {closure:.1e})")
+    fig.tight_layout()
+    return q, summary, fig
 
 
 def run_coaster_circuit(ctx):
@@ -232,6 +281,7 @@ def run_coaster_circuit(ctx):
                                   "sigma_min/sigma_max min": float(rank["sigma_min/sigma_max"].min())}])
     every = max(1, int(round(1.0 / main.meta["output_step"])))
     figs = _figures(tr, fr, cl, sec, main, loads, wf)
+    fq, fq_summary, figs["frame_quality"] = _frame_quality(fr, cl, step=5.0 if fast else 1.0)
     notes = (
         f"Train: {tr.p.n_cars} cars, {tr.p.n_cars - 1} bars, {tr.p.n_wheelsets} wheelsets (11 bodies, 72 coordinates, "
         f"71 constraint rows, 1 DOF; total mass {tr.p.total_mass:.0f} kg). Chain lift on the Lift section at "
@@ -253,7 +303,8 @@ def run_coaster_circuit(ctx):
                 "rank_along_circuit": rank_summary, "speed": tab.iloc[::every].reset_index(drop=True),
                 "wheel_forces": wf.iloc[::every].reset_index(drop=True), "rider_loads": loads.iloc[::every]
                 .reset_index(drop=True), "chain_force": chain_force(main).iloc[::every].reset_index(drop=True),
-                "sections": sec},
+                "sections": sec, "frame_quality_summary": fq_summary,
+                "frame_quality": fq.iloc[::10 if not fast else 2].reset_index(drop=True)},
         figures=figs, notes=notes)
 
 

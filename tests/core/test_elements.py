@@ -146,8 +146,21 @@ def _helix_model(seed):
     return body_on_helix(radius=0.3 + 0.1 * seed, pitch=0.15, sdot0=1.0 + seed)
 
 
+def _coordinate_driver_model(motion_name, seed):
+    """An extra coordinate (with inertia) prescribed by a CoordinateDriver, starting on f(0)."""
+    from core.joints import CoordinateDriver
+
+    f = drivers.as_time_function(_motion(motion_name), label="coordinate driver")
+    x0, xd0 = (float(c) for c in f(0.0)[:2])
+    b = ModelBuilder(3, "driven_coordinate")
+    b.add_coordinate("x", x0, xd0, 1.0 + seed)
+    b.add_joint(CoordinateDriver("D", "x", _motion(motion_name)))
+    return b.build()
+
+
 MODEL_CASES = (
     [pytest.param(_helix_model, id="spatial-user-constraint-helix")]
+    + [pytest.param(lambda s, mo=mo: _coordinate_driver_model(mo, s), id=f"coordinate-driver-{mo}") for mo in MOTIONS]
     + [pytest.param(lambda s, k=k, g=g: _joint_planar(k, s, g), id=f"planar-{k}{'-ground' if g else ''}")
      for k in PLANAR_JOINTS for g in (False, True)]
     + [pytest.param(lambda s, k=k, g=g: _joint_spatial(k, s, g), id=f"spatial-{k}{'-ground' if g else ''}")

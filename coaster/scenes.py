@@ -215,7 +215,7 @@ def _frame_quality(fr, cl, step=1.0):
     end = fr.evaluate(np.array([0.0, cl.length]))
     closure = float(np.max(np.abs(end.R[0] - end.R[1])))
     summary = pd.DataFrame([{
-        "samples": len(q), "step [m]": step,
+        "samples [-]": len(q), "step [m]": step,
         "max |R^T R - I| [-]": q["max |R^T R - I| [-]"].max(), "max |t - g'| [-]": q["|t - g'| [-]"].max(),
         "max |r - g| [m]": q["|r - g| [m]"].max(),
         "max rotation step [rad]": q["rotation step [rad]"].max(),

@@ -265,8 +265,7 @@ class FrenetFrame(FramedCurve):
             return 0.0
         nn = R[:, :, 1]
         dots = _dot(nn[:-1], nn[1:])
-        rel = np.einsum("nki,nkj->nij", R[:-1], R[1:])
-        ang = np.arccos(np.clip((np.trace(rel, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+        ang = _rotation_steps(R)
         flip = dots < 0.0
         if np.any(flip):
             i = int(np.argmax(flip))
@@ -529,6 +528,13 @@ class RotationMinimisingFrame(FramedCurve):
 # ---------------------------------------------------------------------------------------------
 # quality table
 # ---------------------------------------------------------------------------------------------
+def _rotation_steps(R):
+    """Angle (rad) of the rotation R_{i-1}^T R_i between neighbouring frames (n - 1,):
+    cos angle = (trace - 1) / 2."""
+    rel = np.einsum("nki,nkj->nij", R[:-1], R[1:])
+    return np.arccos(np.clip((np.trace(rel, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+
+
 def frame_quality(curve: FramedCurve, centreline: Centreline, L=None, n=1001):
     """Quality of a framed curve along the track, one row per sample.
 
@@ -569,9 +575,7 @@ def frame_quality(curve: FramedCurve, centreline: Centreline, L=None, n=1001):
     expected = np.full(L.size, np.nan)
     if L.size > 1:
         jump[1:] = np.max(np.abs(np.diff(R, axis=0)), axis=(1, 2))
-        rel = np.einsum("nki,nkj->nij", R[:-1], R[1:])
-        tr = np.clip((np.trace(rel, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-        step[1:] = np.arccos(tr)
+        step[1:] = _rotation_steps(R)
         om_mid = curve.evaluate(0.5 * (L[1:] + L[:-1])).omega
         expected[1:] = np.linalg.norm(om_mid, axis=1) * np.diff(L)
     k = np.linalg.norm(d[2], axis=1)

@@ -740,23 +740,25 @@ def _with_neighbours(x0, prob, xb, valid, gap, from_scan, Ga):
             i += 1
             i_old += 1
         if valid[p] and gap[p] < 0.0:
-            for j in range(no):
-                for c in range(4):
-                    x1[i, c] = xb[p, c]
-                x1[i, 1] += NEIGHBOUR_OFFSETS[j]
-                x1[i, 3] += NEIGHBOUR_OFFSETS[j]
-                prob1[i] = p
-                i += 1
+            i = _put_neighbours(x1, prob1, i, xb[p], p)
         for k in range(k0, i_old):
             if from_scan[k] and not np.isfinite(Ga[k]):
-                for j in range(no):
-                    for c in range(4):
-                        x1[i, c] = x0[k, c]
-                    x1[i, 1] += NEIGHBOUR_OFFSETS[j]
-                    x1[i, 3] += NEIGHBOUR_OFFSETS[j]
-                    prob1[i] = p
-                    i += 1
+                i = _put_neighbours(x1, prob1, i, x0[k], p)
     return x1, prob1, n_new
+
+
+@_jit
+def _put_neighbours(x1, prob1, i, centre, p):
+    """Rows i, i+1, ... of (x1, prob1): ``centre`` moved by each NEIGHBOUR_OFFSETS on the wheel
+    profile (and the rail coordinate alike), for problem p; returns the next free row."""
+    for j in range(len(NEIGHBOUR_OFFSETS)):
+        for c in range(4):
+            x1[i, c] = centre[c]
+        x1[i, 1] += NEIGHBOUR_OFFSETS[j]
+        x1[i, 3] += NEIGHBOUR_OFFSETS[j]
+        prob1[i] = p
+        i += 1
+    return i
 
 
 @accept_kernel

@@ -353,7 +353,6 @@ def test_patch_shares_never_load_one_point_twice_and_share_only_within_a_zone():
 CURVING_STATES = Path(__file__).with_name("curving_states_fastsim_10ms.npz")
 
 
-@pytest.mark.skipif(not CURVING_STATES.exists(), reason="state file missing")
 def test_curving_forces_are_the_same_fresh_and_after_any_history():
     """States of the Manchester coach in the 200 m curve (scene railway-curving, FASTSIM at
     10 m/s; written by benchmarks/railway_vehicle.py --write-test-states): at each target state the

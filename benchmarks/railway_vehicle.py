@@ -85,46 +85,57 @@ def real_time(method="jit-dop853", rtol=1e-4, V=10.0, T=30.0):
     t0 = time.perf_counter()
     res = simulate(veh.model, (0.0, T), method, q0=q0, v0=v0, rtol=rtol, atol=rtol * 1e-2, n_output=int(T * 10) + 1)
     wall = time.perf_counter() - t0
-    # cost of one right-hand side (all kinds) and of the contact kernel alone, at a state in the curve
+    # where the time goes: at 10 states along the run (every 3 s), the accepted-step update and
+    # the right-hand side one mean step h later (the state integrated over h; the search state
+    # of the state before, as in the stages of a step)
     m = veh.model
-    k = len(res.t) // 2
-    q, v = np.array(res.q[k]), np.array(res.v[k])
-    m.begin_run(res.t[k], q, v)
-    cm = compile_model(m)
-    ws = D.make_workspace(cm)
-    st = cm.initial_states()
-    Q = np.zeros(m.n_v)
-    n = 2000
-    t0 = time.perf_counter()
-    for _ in range(n):
-        Q[:] = 0.0
-        D.body_states(cm.fields["lay"], q, v, ws)
-        D.forces(cm.data, st, ws, res.t[k], q, v, Q)
-    rhs = (time.perf_counter() - t0) / n
-    kc = next(i for i, r in enumerate(cm.force_kinds) if r.what == "wheel-rail contact")
-    rec = cm.force_kinds[kc]
-    sk = st[cm._st_off[kc]:cm._st_off[kc + 1]].reshape(cm._st_n[kc], cm._st_w[kc]).copy()
-    err = np.zeros(3, np.int64)
-    f = rec.forces.dispatcher
-    t0 = time.perf_counter()
-    for _ in range(n):
-        f(res.t[k], q, v, ws.r, ws.A, ws.rd, ws.w, cm.fields["lay"], rec.fd, rec.ix, sk, Q, err)
-    contact = (time.perf_counter() - t0) / n
-    acc = rec.accept.dispatcher
-    na = 300
-    t0 = time.perf_counter()
-    for _ in range(na):
-        s2 = sk.copy()
-        acc(res.t[k], q, v, ws.r, ws.A, ws.rd, ws.w, cm.fields["lay"], rec.fd, rec.ix, s2, err)
-    accept = (time.perf_counter() - t0) / na
     c = res.counters
+    h = T / c["n_steps"]
+    rhs_t, contact_t, accept_t = [], [], []
+    cm = None
+    for k in range(15, len(res.t), 30):
+        q, v, tk = np.array(res.q[k]), np.array(res.v[k]), float(res.t[k])
+        m.begin_run(tk, q, v)
+        cm = compile_model(m) if cm is None else cm
+        ws = D.make_workspace(cm)
+        st = cm.initial_states()
+        for _ in range(3):
+            D.accept(cm.data, st, ws, tk, q, v)
+        vd, lam = np.zeros(m.n_v), np.zeros(max(1, cm.data.act.shape[0]))
+        r1 = simulate(m, (tk, tk + h), method, q0=q, v0=v, rtol=rtol, atol=rtol * 1e-2, n_output=2)
+        q1, v1 = np.array(r1.q[-1]), np.array(r1.v[-1])
+        n = 300
+        t0 = time.perf_counter()
+        for _ in range(n):
+            D.accelerations(cm.data, st, ws, tk + h, q1, v1, 0.0, 0.0, vd, lam)
+        rhs_t.append((time.perf_counter() - t0) / n)
+        kc = next(i for i, r in enumerate(cm.force_kinds) if r.what == "wheel-rail contact")
+        rec = cm.force_kinds[kc]
+        sk = st[cm._st_off[kc]:cm._st_off[kc + 1]].reshape(cm._st_n[kc], cm._st_w[kc])
+        err = np.zeros(3, np.int64)
+        Q = np.zeros(m.n_v)
+        D.body_states(cm.fields["lay"], q1, v1, ws)
+        t0 = time.perf_counter()
+        for _ in range(n):
+            rec.forces.dispatcher(tk + h, q1, v1, ws.r, ws.A, ws.rd, ws.w, cm.fields["lay"], rec.fd, rec.ix, sk, Q, err)
+        contact_t.append((time.perf_counter() - t0) / n)
+        na = 30
+        s2 = st.copy()
+        t0 = time.perf_counter()
+        for _ in range(na):
+            s2[:] = st
+            D.accept(cm.data, s2, ws, tk + h, q1, v1)
+        accept_t.append((time.perf_counter() - t0) / na)
+    rhs, contact, accept = float(np.mean(rhs_t)), float(np.mean(contact_t)), float(np.mean(accept_t))
     return {"method": method, "rtol": rtol, "speed [m/s]": V, "simulated [s]": T, "status": res.status,
             "wall time, integration [s]": wall, "real-time factor [-]": T / wall,
             "wall time incl. build and preload [s]": wall_all, "steps": c["n_steps"], "rejected": c["n_rejected"],
-            "rhs": c["n_rhs"], "rhs, all kinds [us]": rhs * 1e6, "contact kernel [us]": contact * 1e6,
-            "accept update [us]": accept * 1e6,
+            "rhs": c["n_rhs"], "rhs per step [-]": c["n_rhs"] / c["n_steps"],
+            "wall time per step [us]": wall / c["n_steps"] * 1e6,
+            "rhs incl. solve, mean of 10 states [us]": rhs * 1e6, "contact kernel, mean of 10 states [us]": contact * 1e6,
+            "accept update, mean of 10 states [us]": accept * 1e6,
             "share: contact in rhs [-]": c["n_rhs"] * contact / wall,
-            "share: other kinds in rhs [-]": c["n_rhs"] * (rhs - contact) / wall,
+            "share: rest of the rhs (other kinds, solve) [-]": c["n_rhs"] * (rhs - contact) / wall,
             "share: accepted-step updates [-]": c["n_steps"] * accept / wall}
 
 

@@ -6,6 +6,14 @@ backtracking across passes, zone clipping, linearised last step) written per pro
 It is used only when numba is installed (``pip install numba``); the benchmark
 ``benchmarks/railway_contact_speed.py`` shows why (the per-call numpy overhead dominates for the
 16 small problems of a 4-wheelset vehicle).  Tests check that both give the same contacts.
+
+The kernels are written for the vehicle's real-time factor, without changing a single bit of the
+results (the curving runs are bit-identical before and after, checked on whole runs): the inner
+kernels (:func:`evaluate`, the iteration loop of :func:`newton`, the piecewise polynomials)
+allocate nothing and are compiled without numba's reference counting, which otherwise counts
+every array argument up and down on each call (about 50 atomic operations per pass of the
+Newton iteration); 3-vectors that are not outputs stay scalars; the track frame is evaluated
+only in the columns a caller reads; the scan interpolates its three rail tables with one search.
 """
 
 from __future__ import annotations
@@ -28,37 +36,73 @@ __all__ = ["HAVE_NUMBA", "newton_kernel", "scan_kernel", "reduced_min_kernel"]
 # closures built by a factory got a new cache entry (and a recompilation) in every process.
 if HAVE_NUMBA:
     njit = numba.njit(cache=True, fastmath=False)
+    # kernels that allocate nothing: compiled without numba's reference counting, which would
+    # otherwise increment and decrement every array argument on each call (about 50 atomic
+    # operations per call of ``evaluate``, a fifth of the contact search's time)
+    njit_norc = numba.njit(cache=True, fastmath=False, _nrt=False)
 
-    @njit
+    @njit_norc
     def ppeval(inner, breaks, stack, x, out):
+        """Piecewise polynomial (local coefficients, highest power first) at x: the first
+        ``len(out)`` components (all of them when ``out`` is as long as the stack is wide).
+        Horner's scheme per component, the components in the inner loop (contiguous)."""
+        i = np.searchsorted(inner, x, side="right")
+        _horner(stack, i, x - breaks[i], out, 0, min(stack.shape[2], out.shape[0]))
+
+    @njit_norc
+    def ppeval_columns(inner, breaks, stack, x, out, columns):
+        """:func:`ppeval` of the column ranges ``columns`` (n, 2) only (half-open, into the
+        same places of ``out``); the other entries of ``out`` are left as they are."""
         i = np.searchsorted(inner, x, side="right")
         t = x - breaks[i]
-        k1 = stack.shape[1]
-        q = stack.shape[2]
-        for c in range(q):
-            acc = 0.0
-            for j in range(k1 - 1, -1, -1):
-                acc = acc * t + stack[i, j, c]
-            out[c] = acc
+        for r in range(columns.shape[0]):
+            _horner(stack, i, t, out, columns[r, 0], columns[r, 1])
 
-    @njit
-    def cross(a, b, out):
-        out[0] = a[1] * b[2] - a[2] * b[1]
-        out[1] = a[2] * b[0] - a[0] * b[2]
-        out[2] = a[0] * b[1] - a[1] * b[0]
+    @njit_norc
+    def _horner(stack, i, t, out, c0, c1):
+        for c in range(c0, c1):
+            out[c] = 0.0
+        for j in range(stack.shape[1] - 1, -1, -1):
+            for c in range(c0, c1):
+                out[c] = out[c] * t + stack[i, j, c]
 
-    @njit
+    @njit_norc
+    def ppeval3(inner, breaks, stack, x):
+        """The first three components of :func:`ppeval` (a profile's F, F', F'') as scalars."""
+        i = np.searchsorted(inner, x, side="right")
+        t = x - breaks[i]
+        a0 = a1 = a2 = 0.0
+        for j in range(stack.shape[1] - 1, -1, -1):
+            a0 = a0 * t + stack[i, j, 0]
+            a1 = a1 * t + stack[i, j, 1]
+            a2 = a2 * t + stack[i, j, 2]
+        return a0, a1, a2
+
+    @njit_norc
+    def mv(A, x0, x1, x2):
+        """A (3, 3) times (x0, x1, x2) as three scalars (the summation order of matvec)."""
+        return (A[0, 0] * x0 + A[0, 1] * x1 + A[0, 2] * x2,
+                A[1, 0] * x0 + A[1, 1] * x1 + A[1, 2] * x2,
+                A[2, 0] * x0 + A[2, 1] * x1 + A[2, 2] * x2)
+
+    @njit_norc
+    def cr(a0, a1, a2, b0, b1, b2):
+        """Cross product of two scalar triples."""
+        return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+    @njit_norc
+    def dt(a0, a1, a2, b0, b1, b2):
+        """Dot product of two scalar triples."""
+        return a0 * b0 + a1 * b1 + a2 * b2
+
+    @njit_norc
     def dot(a, b):
         return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
-    @njit
-    def matvec(A, v, out):
-        for i in range(3):
-            out[i] = A[i, 0] * v[0] + A[i, 1] * v[1] + A[i, 2] * v[2]
-
-    @njit
-    def solve4(J, h, dx):
-        M = np.empty((4, 5))
+    @njit_norc
+    def solve4(J, h, dx, M):
+        """dx = -J^-1 h by Gaussian elimination with partial pivoting in the work array M (4, 5);
+        dx = 0 when J is singular."""
         for i in range(4):
             for j in range(4):
                 M[i, j] = J[i, j]
@@ -87,90 +131,100 @@ if HAVE_NUMBA:
                 acc -= M[c, k] * dx[k]
             dx[c] = acc / M[c, c]
 
-    @njit
+    #: Columns of the track frame's piecewise polynomial that :func:`evaluate` reads (layout of
+    #: core.curves.TabulatedFramedCurve: values 0-14, d/ds 15-29, d2/ds2 30-44): r, R, omega,
+    #: r', omega', r''; FRAME_COLUMNS is one past the last.
+    EVALUATE_COLUMNS = np.array([[0, 18], [27, 33]], dtype=np.int64)
+    FRAME_COLUMNS = 33
+
+    @njit_norc
     def evaluate(x, sig, r0, L, ow, orr, Y0, Z0, ca, sa, rws, A,
                  b_inner, b_breaks, b_stack, f_inner, f_breaks, f_stack,
-                 h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal, W, o):
+                 h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal, o):
+        """Residuals h and Jacobian J of the four contact conditions at x = (theta, y_w, s, u)
+        with the points, normal and tangents written into the given arrays (ContactSearch._residual_jac).
+        The 3-vectors that are not outputs stay scalars (no temporary arrays); ``o`` holds at
+        least FRAME_COLUMNS entries."""
         th, yw, s, u = x[0], x[1], x[2], x[3]
-        pr = W[0]
-        ppeval(b_inner, b_breaks, b_stack, yw + ow, pr)
-        F, F1, F2 = pr[0], pr[1], pr[2]
-        ppeval(b_inner, b_breaks, b_stack, u + orr, pr)
-        v, v1, v2 = pr[0], pr[1], pr[2]
+        F, F1, F2 = ppeval3(b_inner, b_breaks, b_stack, yw + ow)
+        v, v1, v2 = ppeval3(b_inner, b_breaks, b_stack, u + orr)
         r = r0 + F
         st, ct = np.sin(th), np.cos(th)
-        loc = W[1]
-        loc[0] = r * st; loc[1] = sig * (yw + L); loc[2] = -r * ct
-        matvec(A, loc, p)
-        for k in range(3):
-            p[k] += rws[k]
-        loc[0] = ct; loc[1] = 0.0; loc[2] = st
-        matvec(A, loc, tth)
-        loc[0] = F1 * st; loc[1] = sig; loc[2] = -F1 * ct
-        matvec(A, loc, ty)
-        dtth = W[2]
-        loc[0] = -st; loc[1] = 0.0; loc[2] = ct
-        matvec(A, loc, dtth)
-        dtyy = W[3]
-        loc[0] = F2 * st; loc[1] = 0.0; loc[2] = -F2 * ct
-        matvec(A, loc, dtyy)
+        p0, p1, p2 = mv(A, r * st, sig * (yw + L), -r * ct)
+        p[0] = p0 + rws[0]
+        p[1] = p1 + rws[1]
+        p[2] = p2 + rws[2]
+        tth[0], tth[1], tth[2] = mv(A, ct, 0.0, st)
+        ty[0], ty[1], ty[2] = mv(A, F1 * st, sig, -F1 * ct)
+        a0, a1, a2 = mv(A, -st, 0.0, ct)  # d tth / d theta
+        y0, y1, y2 = mv(A, F2 * st, 0.0, -F2 * ct)  # d ty / d y_w
         # track frame
-        ppeval(f_inner, f_breaks, f_stack, s, o)
+        ppeval_columns(f_inner, f_breaks, f_stack, s, o, EVALUATE_COLUMNS)
         for i in range(3):
             for j in range(3):
                 R[i, j] = o[3 + 3 * i + j]
-        om = o[12:15]
-        dpos = o[15:18]
-        dom = o[27:30]
-        ddpos = o[30:33]
+        om0, om1, om2 = o[12], o[13], o[14]
         a = Y0 + u * ca - v * sa
         b = Z0 + u * sa + v * ca
-        loc[0] = 0.0; loc[1] = sig * a; loc[2] = b
-        matvec(R, loc, Rl)
-        loc[0] = 0.0; loc[1] = sig * (ca - v1 * sa); loc[2] = sa + v1 * ca
-        matvec(R, loc, tu)
-        dtuu = W[4]
-        loc[0] = 0.0; loc[1] = -sig * v2 * sa; loc[2] = v2 * ca
-        matvec(R, loc, dtuu)
+        Rl[0], Rl[1], Rl[2] = mv(R, 0.0, sig * a, b)
+        tu[0], tu[1], tu[2] = mv(R, 0.0, sig * (ca - v1 * sa), sa + v1 * ca)
+        u0, u1, u2 = mv(R, 0.0, -sig * v2 * sa, v2 * ca)  # d tu / d u
         for k in range(3):
             q[k] = o[k] + Rl[k]
-        omRl = W[5]; omtu = W[6]; tmp = W[7]; tmp2 = W[8]
-        cross(om, Rl, omRl)
-        cross(om, tu, omtu)
-        cross(dom, Rl, tmp)
-        cross(om, omRl, tmp2)
+        r0_, r1_, r2_ = cr(om0, om1, om2, Rl[0], Rl[1], Rl[2])  # om x Rl
+        w0, w1, w2 = cr(om0, om1, om2, tu[0], tu[1], tu[2])  # om x tu
+        m0, m1, m2 = cr(o[27], o[28], o[29], Rl[0], Rl[1], Rl[2])  # om' x Rl
+        k0, k1, k2 = cr(om0, om1, om2, r0_, r1_, r2_)  # om x (om x Rl)
+        ts[0] = o[15] + r0_
+        ts[1] = o[16] + r1_
+        ts[2] = o[17] + r2_
+        qss[0] = o[30] + m0 + k0
+        qss[1] = o[31] + m1 + k1
+        qss[2] = o[32] + m2 + k2
+        c0, c1, c2 = cr(ts[0], ts[1], ts[2], tu[0], tu[1], tu[2])
+        cn = np.sqrt(dt(c0, c1, c2, c0, c1, c2))
+        n[0] = sig * c0 / cn
+        n[1] = sig * c1 / cn
+        n[2] = sig * c2 / cn
         for k in range(3):
-            ts[k] = dpos[k] + omRl[k]
-            qss[k] = ddpos[k] + tmp[k] + tmp2[k]
-        c = W[9]
-        cross(ts, tu, c)
-        cn = np.sqrt(dot(c, c))
-        for k in range(3):
-            n[k] = sig * c[k] / cn
             d[k] = p[k] - q[k]
         # dn/ds, dn/du
-        dcs = W[10]; dcu = W[11]
-        cross(qss, tu, tmp)
-        cross(ts, omtu, tmp2)
-        for k in range(3):
-            dcs[k] = sig * (tmp[k] + tmp2[k]) / cn
-        cross(omtu, tu, tmp)
-        cross(ts, dtuu, tmp2)
-        for k in range(3):
-            dcu[k] = sig * (tmp[k] + tmp2[k]) / cn
-        ps, pu = dot(dcs, n), dot(dcu, n)
-        for k in range(3):
-            dn[0, k] = dcs[k] - ps * n[k]
-            dn[1, k] = dcu[k] - pu * n[k]
-        h[0] = dot(n, tth); h[1] = dot(n, ty); h[2] = dot(d, ts); h[3] = dot(d, tu)
-        J[0, 0] = dot(n, dtth); J[0, 1] = 0.0
-        J[0, 2] = dot(dn[0], tth); J[0, 3] = dot(dn[1], tth)
-        J[1, 0] = F1 * h[0]; J[1, 1] = dot(n, dtyy)
-        J[1, 2] = dot(dn[0], ty); J[1, 3] = dot(dn[1], ty)
-        J[2, 0] = r * dot(tth, ts); J[2, 1] = dot(ty, ts)
-        J[2, 2] = -dot(ts, ts) + dot(d, qss); J[2, 3] = -dot(tu, ts) + dot(d, omtu)
-        J[3, 0] = r * dot(tth, tu); J[3, 1] = dot(ty, tu)
-        J[3, 2] = -dot(ts, tu) + dot(d, omtu); J[3, 3] = -dot(tu, tu) + dot(d, dtuu)
+        e0, e1, e2 = cr(qss[0], qss[1], qss[2], tu[0], tu[1], tu[2])
+        f0, f1, f2 = cr(ts[0], ts[1], ts[2], w0, w1, w2)
+        s0_, s1_, s2_ = sig * (e0 + f0) / cn, sig * (e1 + f1) / cn, sig * (e2 + f2) / cn
+        e0, e1, e2 = cr(w0, w1, w2, tu[0], tu[1], tu[2])
+        f0, f1, f2 = cr(ts[0], ts[1], ts[2], u0, u1, u2)
+        g0, g1, g2 = sig * (e0 + f0) / cn, sig * (e1 + f1) / cn, sig * (e2 + f2) / cn
+        ps = dt(s0_, s1_, s2_, n[0], n[1], n[2])
+        pu = dt(g0, g1, g2, n[0], n[1], n[2])
+        dn[0, 0] = s0_ - ps * n[0]
+        dn[0, 1] = s1_ - ps * n[1]
+        dn[0, 2] = s2_ - ps * n[2]
+        dn[1, 0] = g0 - pu * n[0]
+        dn[1, 1] = g1 - pu * n[1]
+        dn[1, 2] = g2 - pu * n[2]
+        n0, n1, n2 = n[0], n[1], n[2]
+        t0, t1, t2 = tth[0], tth[1], tth[2]
+        b0, b1, b2 = ty[0], ty[1], ty[2]
+        x0, x1, x2 = ts[0], ts[1], ts[2]
+        v0_, v1_, v2_ = tu[0], tu[1], tu[2]
+        d0, d1, d2 = d[0], d[1], d[2]
+        h[0] = dt(n0, n1, n2, t0, t1, t2)
+        h[1] = dt(n0, n1, n2, b0, b1, b2)
+        h[2] = dt(d0, d1, d2, x0, x1, x2)
+        h[3] = dt(d0, d1, d2, v0_, v1_, v2_)
+        J[0, 0] = dt(n0, n1, n2, a0, a1, a2); J[0, 1] = 0.0
+        J[0, 2] = dt(dn[0, 0], dn[0, 1], dn[0, 2], t0, t1, t2)
+        J[0, 3] = dt(dn[1, 0], dn[1, 1], dn[1, 2], t0, t1, t2)
+        J[1, 0] = F1 * h[0]; J[1, 1] = dt(n0, n1, n2, y0, y1, y2)
+        J[1, 2] = dt(dn[0, 0], dn[0, 1], dn[0, 2], b0, b1, b2)
+        J[1, 3] = dt(dn[1, 0], dn[1, 1], dn[1, 2], b0, b1, b2)
+        J[2, 0] = r * dt(t0, t1, t2, x0, x1, x2); J[2, 1] = dt(b0, b1, b2, x0, x1, x2)
+        J[2, 2] = -dt(x0, x1, x2, x0, x1, x2) + dt(d0, d1, d2, qss[0], qss[1], qss[2])
+        J[2, 3] = -dt(v0_, v1_, v2_, x0, x1, x2) + dt(d0, d1, d2, w0, w1, w2)
+        J[3, 0] = r * dt(t0, t1, t2, v0_, v1_, v2_); J[3, 1] = dt(b0, b1, b2, v0_, v1_, v2_)
+        J[3, 2] = -dt(x0, x1, x2, v0_, v1_, v2_) + dt(d0, d1, d2, w0, w1, w2)
+        J[3, 3] = -dt(v0_, v1_, v2_, v0_, v1_, v2_) + dt(d0, d1, d2, u0, u1, u2)
         scal[0] = r; scal[1] = F1; scal[2] = F2; scal[3] = v1; scal[4] = v2
 
     @njit
@@ -186,7 +240,25 @@ if HAVE_NUMBA:
         Rl = np.empty(3); qss = np.empty(3); tth = np.empty(3); ty = np.empty(3); tu = np.empty(3)
         dn = np.empty((2, 3)); R = np.empty((3, 3)); scal = np.empty(5)
         x = np.empty(4); x_acc = np.empty(4); dx_acc = np.zeros(4); xn = np.empty(4)
-        W = np.empty((12, 3)); o = np.empty(f_stack.shape[2])
+        o = np.empty(min(FRAME_COLUMNS, f_stack.shape[2]))
+        M4 = np.empty((4, 5))
+        max_it = _newton_loop(x0, sig, r0, L, ow, orr, Y0, Z0, ca, sa, lo, hi, rws, A,
+                              b_inner, b_breaks, b_stack, f_inner, f_breaks, f_stack,
+                              tol_lin, max_iter, maxstep, wts, X, H0, conv, GAP, S, V,
+                              h, J, dx, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal,
+                              x, x_acc, dx_acc, xn, o, M4)
+        return X, H0, conv, max_it, GAP, S, V
+
+    @njit_norc
+    def _newton_loop(x0, sig, r0, L, ow, orr, Y0, Z0, ca, sa, lo, hi, rws, A,
+                     b_inner, b_breaks, b_stack, f_inner, f_breaks, f_stack,
+                     tol_lin, max_iter, maxstep, wts, X, H0, conv, GAP, S, V,
+                     h, J, dx, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal,
+                     x, x_acc, dx_acc, xn, o, M4):
+        """The iterations of :func:`newton`, pair by pair, into its arrays (allocates nothing,
+        compiled without reference counting: the many array arguments of :func:`evaluate`
+        would otherwise be counted up and down on every pass); returns the most passes used."""
+        P = x0.shape[0]
         max_it = 0
         for pi in range(P):
             for k in range(4):
@@ -198,11 +270,12 @@ if HAVE_NUMBA:
             was_clipped = False
             cvd = False
             it = 0
+            rp, Ap = rws[pi], A[pi]  # views made once per problem, not per pass
             for it in range(1, max_iter + 1):
                 evaluate(x, sig[pi], r0[pi], L[pi], ow[pi], orr[pi], Y0[pi], Z0[pi], ca[pi],
-                         sa[pi], rws[pi], A[pi], b_inner, b_breaks, b_stack, f_inner, f_breaks,
-                         f_stack, h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal, W, o)
-                solve4(J, h, dx)
+                         sa[pi], rp, Ap, b_inner, b_breaks, b_stack, f_inner, f_breaks,
+                         f_stack, h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal, o)
+                solve4(J, h, dx, M4)
                 big = 0.0
                 scale = 1.0
                 for k in range(4):
@@ -293,8 +366,42 @@ if HAVE_NUMBA:
                 conv[pi] = False
             for k in range(3):
                 V[pi, 0, k] = p[k]; V[pi, 1, k] = q[k]; V[pi, 2, k] = n[k]
-        return X, H0, conv, max_it, GAP, S, V
+        return max_it
 
+
+    @njit_norc
+    def interp3(x, xp, f1, f2, f3, o1, o2, o3):
+        """``o_k = np.interp(x, xp, f_k)`` for three tables on one abscissa ``xp`` (increasing),
+        one search per point; the arithmetic and edge cases of numba's np.interp (NumPy's
+        arr_interp: a NaN x gives NaN, beyond the ends the end values, the other direction
+        where the interpolation gives NaN)."""
+        n = xp.shape[0]
+        for i in range(x.shape[0]):
+            xv = x[i]
+            if np.isnan(xv):
+                o1[i] = o2[i] = o3[i] = xv
+                continue
+            j = np.searchsorted(xp, xv, side="right") - 1
+            if j < 0:
+                o1[i], o2[i], o3[i] = f1[0], f2[0], f3[0]
+            elif j >= n - 1:
+                o1[i], o2[i], o3[i] = f1[n - 1], f2[n - 1], f3[n - 1]
+            elif xp[j] == xv:
+                o1[i], o2[i], o3[i] = f1[j], f2[j], f3[j]
+            else:
+                o1[i] = _lerp(xv, xp, f1, j)
+                o2[i] = _lerp(xv, xp, f2, j)
+                o3[i] = _lerp(xv, xp, f3, j)
+
+    @njit_norc
+    def _lerp(xv, xp, fp, j):
+        slope = (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j])
+        r = slope * (xv - xp[j]) + fp[j]
+        if np.isnan(r):  # if we get NaN in one direction, try the other
+            r = slope * (xv - xp[j + 1]) + fp[j + 1]
+            if np.isnan(r) and fp[j] == fp[j + 1]:
+                r = fp[j]
+        return r
 
     @njit
     def scan(r, ax, d, pos, tan, lat, up, sig, L, yg, rg, F1g, side_left, b0, u0, Y0, Z0,
@@ -304,6 +411,7 @@ if HAVE_NUMBA:
         Yo = np.empty(G); Zw = np.empty(G); xi = np.empty(G); beta = np.empty(G)
         gap = np.empty(G); h4 = np.empty(G); ok = np.empty(G, dtype=np.bool_)
         gmid = np.empty(G - 1); tt = np.empty(G - 1); th = np.empty(G)
+        ug = np.empty(G); Yr = np.empty(G); Zr = np.empty(G)
         for p in range(P):
             # the lead angle of each profile line (ContactSearch.scan_lead_angle)
             f0 = ax[p, 1] * d[p, 2] - ax[p, 2] * d[p, 1]
@@ -337,9 +445,9 @@ if HAVE_NUMBA:
                 beta[g] = np.arctan2(t0 * up[p, 0] + t1 * up[p, 1] + t2 * up[p, 2],
                                      (t0 * lat[p, 0] + t1 * lat[p, 1] + t2 * lat[p, 2]) * sig[p])
             if side_left[p]:
-                ug = np.interp(beta, b0, u0); Yr = np.interp(beta, b0, Y0); Zr = np.interp(beta, b0, Z0)
+                interp3(beta, b0, u0, Y0, Z0, ug, Yr, Zr)
             else:
-                ug = np.interp(beta, b1, u1); Yr = np.interp(beta, b1, Y1); Zr = np.interp(beta, b1, Z1)
+                interp3(beta, b1, u1, Y1, Z1, ug, Yr, Zr)
             j0 = 0
             gbest = 1e300
             for g in range(G):
@@ -383,18 +491,17 @@ if HAVE_NUMBA:
 
 
 
-    @njit
+    @njit_norc
     def _reduced_gap(x, sig, r0, L, ow, orr, Y0, Z0, ca, sa, rws, A, b_inner, b_breaks, b_stack,
                      f_inner, f_breaks, f_stack, lo, hi, maxstep, buf):
         """psi(y): solve h1 = h3 = h4 = 0 for (theta, s, u) at the wheel profile coordinate
         x[1] (x updated in place, warm start); returns the gap d . n, +inf when the 3x3
         Newton does not converge or leaves the rail's range (ContactSearch._reduced)."""
-        h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal, W, o = buf
-        M = np.empty((3, 4))
+        h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R, scal, o, M, dx = buf
         for it in range(14):
             evaluate(x, sig, r0, L, ow, orr, Y0, Z0, ca, sa, rws, A, b_inner, b_breaks, b_stack,
                      f_inner, f_breaks, f_stack, h, J, p, q, n, d, ts, Rl, qss, tth, ty, tu, dn, R,
-                     scal, W, o)
+                     scal, o)
             if abs(h[0]) < 1e-12 and abs(h[2]) < 1e-13 and abs(h[3]) < 1e-13:
                 break
             k3 = (0, 2, 3)
@@ -422,7 +529,6 @@ if HAVE_NUMBA:
                         M[rr, k] -= f * M[c, k]
             if not ok:
                 return np.inf
-            dx = np.empty(3)
             for c in range(2, -1, -1):
                 acc = M[c, 3]
                 for k in range(c + 1, 3):
@@ -461,8 +567,8 @@ if HAVE_NUMBA:
         ok = np.zeros(P, dtype=np.bool_)
         buf = (np.empty(4), np.empty((4, 4)), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
                np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
-               np.empty((2, 3)), np.empty((3, 3)), np.empty(5), np.empty((12, 3)),
-               np.empty(f_stack.shape[2]))
+               np.empty((2, 3)), np.empty((3, 3)), np.empty(5),
+               np.empty(min(FRAME_COLUMNS, f_stack.shape[2])), np.empty((3, 4)), np.empty(3))
         xs = np.empty(4)
         xbest = np.empty(4)
         gr = 0.5 * (np.sqrt(5.0) - 1.0)

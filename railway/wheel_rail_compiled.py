@@ -49,7 +49,7 @@ from core.compiled.protocol import (
     force_kernel,
 )
 
-from ._kernels import newton, ppeval, reduced_min, scan
+from ._kernels import newton, ppeval, ppeval_columns, reduced_min, scan
 from .forces import kernel as contact_forces
 from .wheel_rail import ACCEPT_RANKS, BLEND_GAP, DUPLICATE, NEIGHBOUR_OFFSETS, SEPARATION, climb_message
 
@@ -134,12 +134,17 @@ def _seg3(fd, ix, e, k):
     return fd[e, o:o + n0 * n1 * n2].reshape((n0, n1, n2))
 
 
+#: Track-frame columns the projection's iterations read: r, r', r'' (railway._kernels.EVALUATE_COLUMNS)
+PROJECT_COLUMNS = np.array([[0, 3], [15, 18], [30, 33]], dtype=np.int64)
+
+
 @_jit
 def _project(f_inner, f_breaks, f_stack, p, s0, length, closed, o):
-    """Arc length of the foot of the perpendicular from p (NaN when not over the track)."""
+    """Arc length of the foot of the perpendicular from p (NaN when not over the track); ``o``
+    holds every column of the frame at the returned arc length."""
     s = s0
     for _ in range(30):
-        ppeval(f_inner, f_breaks, f_stack, s, o)
+        ppeval_columns(f_inner, f_breaks, f_stack, s, o, PROJECT_COLUMNS)
         e0, e1, e2 = p[0] - o[0], p[1] - o[1], p[2] - o[2]
         f = e0 * o[15] + e1 * o[16] + e2 * o[17]
         df = -(o[15] * o[15] + o[16] * o[16] + o[17] * o[17]) + e0 * o[30] + e1 * o[31] + e2 * o[32]
@@ -195,9 +200,18 @@ def _solve(fd, ix, e, rws, Ans, x0, prob):
     """Newton from (seed, problem) pairs (x0[k] for problem prob[k], sorted by problem); per
     problem the lowest valid gap (ties: the first pair).
 
-    Returns xb (P, 4), valid (P), gap (P), S (P, 11), V (P, 3, 3), X (K, 4), G (K)."""
-    n_ws = ix[e, IX_NWS]
-    P = 4 * n_ws
+    Returns xb (P, 4), valid (P), gap (P), S (P, 11), V (P, 3, 3), X (K, 4), G (K), and every
+    pair's S (K, 11) and V (K, 3, 3)."""
+    X, Ga, Sp, Vp = _newton_pairs(fd, ix, e, rws, Ans, x0, prob)
+    xb, valid, gap, Sb, Vb = _best(fd, ix, e, prob, X, Ga, Sp, Vp)
+    return xb, valid, gap, Sb, Vb, X, Ga, Sp, Vp
+
+
+@_jit
+def _newton_pairs(fd, ix, e, rws, Ans, x0, prob):
+    """Newton from every (seed, problem) pair on its own: X (K, 4), G (K) (the gap, +inf where
+    the pair is no contact: not converged, a saddle, too deep or outside its zone), S (K, 11),
+    V (K, 3, 3).  Each pair's result depends on that pair only."""
     K = prob.shape[0]
     sig, r0, L = _seg1(fd, ix, e, K_SIG), _seg1(fd, ix, e, K_R0), _seg1(fd, ix, e, K_L)
     ow, orr = _seg1(fd, ix, e, K_OW), _seg1(fd, ix, e, K_ORR)
@@ -206,6 +220,9 @@ def _solve(fd, ix, e, rws, Ans, x0, prob):
     lo, hi = _seg2(fd, ix, e, K_LO), _seg2(fd, ix, e, K_HI)
     lo_e, hi_e = _seg2(fd, ix, e, K_LO_E), _seg2(fd, ix, e, K_HI_E)
     sc = _seg1(fd, ix, e, K_SCAL)
+    Ga = np.full(K, np.inf)
+    if K == 0:
+        return x0.copy(), Ga, np.zeros((0, 11)), np.zeros((0, 3, 3))
     msig, mr0, mL, mow, morr = np.empty(K), np.empty(K), np.empty(K), np.empty(K), np.empty(K)
     mY0, mZ0, mca, msa = np.empty(K), np.empty(K), np.empty(K), np.empty(K)
     mlo, mhi = np.empty((K, 4)), np.empty((K, 4))
@@ -223,20 +240,11 @@ def _solve(fd, ix, e, rws, Ans, x0, prob):
             mr[i, c] = rws[k, c]
             for d in range(3):
                 mA[i, c, d] = Ans[k, c, d]
-    Ga = np.full(K, np.inf)
-    xb = np.zeros((P, 4))
-    valid = np.zeros(P, dtype=np.bool_)
-    gap = np.full(P, np.inf)
-    Sb = np.full((P, 11), np.nan)
-    Vb = np.full((P, 3, 3), np.nan)
-    if K == 0:
-        return xb, valid, gap, Sb, Vb, x0.copy(), Ga, np.zeros((0, 11)), np.zeros((0, 3, 3))
     X, H0, conv, it, GAP, S, V = newton(
         x0, msig, mr0, mL, mow, morr, mY0, mZ0, mca, msa, mlo, mhi, mr, mA,
         _seg1(fd, ix, e, K_B_INNER), _seg1(fd, ix, e, K_B_BREAKS), _seg3(fd, ix, e, K_B_STACK),
         _seg1(fd, ix, e, K_F_INNER), _seg1(fd, ix, e, K_F_BREAKS), _seg3(fd, ix, e, K_F_STACK),
         sc[SC_TOL], ix[e, IX_MAXIT], _seg1(fd, ix, e, K_MAXSTEP), _seg1(fd, ix, e, K_WTS))
-    best = np.full(P, -1, dtype=np.int64)
     for i in range(K):
         p = prob[i]
         ok = conv[i] and np.isfinite(GAP[i]) and GAP[i] > -sc[SC_MAXPEN]
@@ -244,10 +252,29 @@ def _solve(fd, ix, e, rws, Ans, x0, prob):
             if not (X[i, c] > lo_e[p, c] and X[i, c] < hi_e[p, c]):
                 ok = False
         Ga[i] = GAP[i] if ok else np.inf
+    return X, Ga, S, V
+
+
+@_jit
+def _best(fd, ix, e, prob, X, Ga, S, V):
+    """Per problem the pair of lowest gap G (ties: the first pair; a problem whose pairs are all
+    +inf keeps its first pair's point, not valid), then the zone-overlap duplicates dropped:
+    xb (P, 4), valid (P), gap (P), Sb (P, 11), Vb (P, 3, 3)."""
+    n_ws = ix[e, IX_NWS]
+    P = 4 * n_ws
+    sc = _seg1(fd, ix, e, K_SCAL)
+    xb = np.zeros((P, 4))
+    valid = np.zeros(P, dtype=np.bool_)
+    gap = np.full(P, np.inf)
+    Sb = np.full((P, 11), np.nan)
+    Vb = np.full((P, 3, 3), np.nan)
+    best = np.full(P, -1, dtype=np.int64)
+    for i in range(prob.shape[0]):
+        p = prob[i]
         if best[p] < 0 or Ga[i] < gap[p]:
             best[p] = i
             gap[p] = Ga[i]
-            valid[p] = ok
+            valid[p] = np.isfinite(Ga[i])
     for p in range(P):
         i = best[p]
         if i < 0:
@@ -261,7 +288,43 @@ def _solve(fd, ix, e, rws, Ans, x0, prob):
                 for d in range(3):
                     Vb[p, c, d] = V[i, c, d]
     _dedup(xb, valid, gap, Sb, Vb, sc[SC_YSPLIT])
-    return xb, valid, gap, Sb, Vb, X, Ga, S, V
+    return xb, valid, gap, Sb, Vb
+
+
+@_jit
+def _solve_added(fd, ix, e, rws, Ans, x1, prob1, src, X0, G0, S0, V0):
+    """:func:`_solve` of the pairs (x1, prob1) where row i is the already solved pair
+    ``src[i]`` of (X0, G0, S0, V0) or, with ``src[i] < 0``, a new one: Newton runs on the new
+    pairs only (each pair's result depends on that pair alone, so this equals solving all)."""
+    K1 = prob1.shape[0]
+    n_new = 0
+    for i in range(K1):
+        if src[i] < 0:
+            n_new += 1
+    xn = np.empty((n_new, 4))
+    pn = np.empty(n_new, dtype=np.int64)
+    j = 0
+    for i in range(K1):
+        if src[i] < 0:
+            for c in range(4):
+                xn[j, c] = x1[i, c]
+            pn[j] = prob1[i]
+            j += 1
+    Xn, Gn, Sn, Vn = _newton_pairs(fd, ix, e, rws, Ans, xn, pn)
+    X = np.empty((K1, 4))
+    Ga = np.empty(K1)
+    Sp = np.empty((K1, 11))
+    Vp = np.empty((K1, 3, 3))
+    j = 0
+    for i in range(K1):
+        k = src[i]
+        if k >= 0:
+            X[i], Ga[i], Sp[i], Vp[i] = X0[k], G0[k], S0[k], V0[k]
+        else:
+            X[i], Ga[i], Sp[i], Vp[i] = Xn[j], Gn[j], Sn[j], Vn[j]
+            j += 1
+    xb, valid, gap, Sb, Vb = _best(fd, ix, e, prob1, X, Ga, Sp, Vp)
+    return xb, valid, gap, Sb, Vb, X, Ga, Sp, Vp
 
 
 @_jit
@@ -714,9 +777,10 @@ def _accept_pairs(fd, ix, e, seeds, s, s_prev, val_prev, rws, Ans, reseed, o):
 
 @_jit
 def _with_neighbours(x0, prob, xb, valid, gap, from_scan, Ga):
-    """(x1, prob1, n_new): the pairs x0 with NEIGHBOUR_OFFSETS seeds beside every penetrating
-    contact and beside every flagged scan seed whose Newton iteration was refused (Ga = inf)
-    (railway.wheel_rail.neighbour_seeds), sorted by problem (stable: existing pairs first)."""
+    """(x1, prob1, src, n_new): the pairs x0 with NEIGHBOUR_OFFSETS seeds beside every
+    penetrating contact and beside every flagged scan seed whose Newton iteration was refused
+    (Ga = inf) (railway.wheel_rail.neighbour_seeds), sorted by problem (stable: existing pairs
+    first); ``src[i]`` is the row of x0 that row i copies, -1 for a new seed."""
     P = valid.shape[0]
     K = prob.shape[0]
     no = len(NEIGHBOUR_OFFSETS)
@@ -729,6 +793,7 @@ def _with_neighbours(x0, prob, xb, valid, gap, from_scan, Ga):
             n_new += no
     x1 = np.empty((K + n_new, 4))
     prob1 = np.empty(K + n_new, dtype=np.int64)
+    src = np.full(K + n_new, -1, dtype=np.int64)
     i = 0
     i_old = 0
     for p in range(P):
@@ -737,6 +802,7 @@ def _with_neighbours(x0, prob, xb, valid, gap, from_scan, Ga):
             for c in range(4):
                 x1[i, c] = x0[i_old, c]
             prob1[i] = p
+            src[i] = i_old
             i += 1
             i_old += 1
         if valid[p] and gap[p] < 0.0:
@@ -744,7 +810,7 @@ def _with_neighbours(x0, prob, xb, valid, gap, from_scan, Ga):
         for k in range(k0, i_old):
             if from_scan[k] and not np.isfinite(Ga[k]):
                 i = _put_neighbours(x1, prob1, i, x0[k], p)
-    return x1, prob1, n_new
+    return x1, prob1, src, n_new
 
 
 @_jit
@@ -799,10 +865,11 @@ def wheel_rail_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
                 break
             reseed = True
         # seeds beside every penetrating contact (railway.wheel_rail.neighbour_seeds)
-        x1, prob1, n_new = _with_neighbours(x0, prob, xb, valid, gap, from_scan, Gm)
+        x1, prob1, src, n_new = _with_neighbours(x0, prob, xb, valid, gap, from_scan, Gm)
         if n_new > 0:
+            # Newton on the new seeds only; the pairs solved above keep their results
+            xb, valid, gap, S, V, X, Gm, Sp, Vp = _solve_added(fd, ix, e, rws, Ans, x1, prob1, src, X, Gm, Sp, Vp)
             x0, prob = x1, prob1
-            xb, valid, gap, S, V, X, Gm, Sp, Vp = _solve(fd, ix, e, rws, Ans, x0, prob)
             if reseed:
                 prevm = np.zeros(P, dtype=np.bool_)
                 for p in range(P):

@@ -472,12 +472,14 @@ def run_curving(law, V, T=None, definition=None, track=None, method=METHOD, rtol
     return res, veh
 
 
-def curve_window(H):
+def curve_window(H, curve_length=None):
     """Rows of a contact history at the times when every wheelset is in the full curve, at
-    least 30 m from both transitions (quasi-static curving of the whole vehicle)."""
+    least 30 m from both transitions (quasi-static curving of the whole vehicle); the track of
+    :func:`curving_track` with its curve ``curve_length`` long (default: the scene's)."""
     c = CURVE
+    length = c["curve_length"] if curve_length is None else curve_length
     lo = c["lead"] + c["transition"] + 30.0
-    hi = c["lead"] + c["transition"] + c["curve_length"] - 30.0
+    hi = c["lead"] + c["transition"] + length - 30.0
     g = H.groupby("t [s]")["s [m]"]
     inside = (g.min() >= lo) & (g.max() <= hi)
     return H[H["t [s]"].isin(inside.index[inside.to_numpy()])]

@@ -87,6 +87,29 @@ def test_lateral_equilibrium_in_the_full_curve():
     assert float(-sumY.mean()) == pytest.approx(need, rel=2e-2)
 
 
+def test_curve_window_keeps_the_times_with_every_wheelset_in_the_full_curve():
+    """The window starts 30 m after the entry transition and ends 30 m before the exit one, on the
+    scene's curve and on a longer one (curve_length), and needs every wheelset inside."""
+    import pandas as pd
+
+    c = CURVE
+    lo = c["lead"] + c["transition"] + 30.0
+    rows = []
+    for k, s_lead in enumerate(np.arange(lo - 5.0, lo + 400.0, 5.0)):
+        for ws, back in (("ws1", 0.0), ("ws2", 18.0)):  # trailing wheelset 18 m behind
+            rows.append({"t [s]": float(k), "wheel": f"{ws} left", "s [m]": s_lead - back})
+    H = pd.DataFrame(rows)
+
+    def s_range(W):
+        lead = W[W["wheel"] == "ws1 left"]["s [m]"]
+        return lead.min(), lead.max()
+
+    hi = c["lead"] + c["transition"] + c["curve_length"] - 30.0
+    assert s_range(curve_window(H)) == (lo + 20.0, hi)  # first 5 m grid point with ws2 >= lo
+    hi_long = c["lead"] + c["transition"] + 400.0 - 30.0
+    assert s_range(curve_window(H, curve_length=400.0)) == (lo + 20.0, hi_long)
+
+
 def test_sweep_parallel_equals_serial():
     from core.sweep import run_sweep
 

@@ -19,8 +19,9 @@
 4. The flying wheelset and the linear critical-speed sweep, timed.
 
 Run:  .venv/bin/python benchmarks/railway_vehicle.py [--quick]
-Writes benchmarks/results/railway_vehicle.md (and .csv tables).  One process, one core (numba
-is single-threaded here); run it on an otherwise idle machine.
+Writes benchmarks/results/railway_vehicle.md (and .csv tables), headed by the processor it ran on
+(wall times belong to a processor).  One process, one core (numba is single-threaded here); run it
+on an otherwise idle machine.
 """
 
 from __future__ import annotations
@@ -280,6 +281,7 @@ def main(argv=None):
     ap.add_argument("--write-test-states", action="store_true",
                     help="only write the curving states of the history test (tests/railway)")
     args = ap.parse_args(argv)
+    from _host import host_line
     from core.results import markdown_table
 
     if args.write_test_states:
@@ -296,7 +298,7 @@ def main(argv=None):
     for name, df in (("railway_vehicle_work_precision", wp), ("railway_vehicle_real_time", rt),
                      ("railway_vehicle_real_time_accuracy", acc), ("railway_vehicle_timed", tc)):
         df.to_csv(RESULTS / f"{name}.csv", index=False)
-    text = ["# Railway vehicle benchmarks", "", f"load average {load0:.2f} -> {load1:.2f}", "",
+    text = ["# Railway vehicle benchmarks", "", f"host: {host_line()}", "", f"load average {load0:.2f} -> {load1:.2f}", "",
             "## Work-precision, 5 s of curving (20 m/s, Polach 2000)", "", markdown_table(wp, floatfmt=".4g"), "",
             "## Real-time factor, 30 s on the 200 m curve", "", markdown_table(rt.T.reset_index(), floatfmt=".4g"), "",
             "## Real-time factor against accuracy, the same 30 s", "", f"Reference: {acc.attrs['reference']}.", "",

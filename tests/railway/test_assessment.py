@@ -14,9 +14,12 @@ from core.errors import InputError
 from railway.assessment import (
     assessment_limits,
     derailment_quotient,
+    lowpass,
     max_pressure,
     nadal_limit,
+    sliding_mean,
     wear_number,
+    wheel_force_statistics,
     wheel_forces_track,
 )
 from railway.creepage import contact_frame
@@ -167,3 +170,83 @@ def test_limits_are_data_with_their_source_flag():
     assert row["limit [-]"] == 0.8
     assert "UIC" in row["source"] and "second-hand" in row["status"]
     assert not lim["source"].str.contains("EN 14363").any()  # not found: not held
+
+
+# ------------------------------------------------------------------------------------------
+# Track-test processing: low-pass, sliding mean, percentiles (A6, A7)
+# ------------------------------------------------------------------------------------------
+
+def test_lowpass_gain_is_the_squared_butterworth_gain():
+    """A6: zero-phase digital Butterworth of order 4 at 20 Hz, sampled at 1 kHz: a harmonic of
+    frequency f keeps 1/(1 + (tan(pi f/fs)/tan(pi 20/fs))^8) (1/2 at the cut-off, 3e-9 at the
+    200 Hz wheelset bounce); measured on the middle of a 4 s record."""
+    fs = 1000.0
+    t = np.arange(0.0, 4.0, 1.0 / fs)
+    mid = (t > 1.0) & (t < 3.0)
+    for f, A in ((5.0, 1.0), (200.0, 1.0), (20.0, 1.0)):
+        x = A * np.sin(2 * np.pi * f * t)
+        y = lowpass(x, fs)
+        gain = np.sqrt(2.0 * np.mean(y[mid] ** 2))
+        expected = 1.0 / (1.0 + (np.tan(np.pi * f / fs) / np.tan(np.pi * 20.0 / fs)) ** 8)
+        assert gain == pytest.approx(expected, rel=2e-3, abs=1e-10)
+        if f < 20.0:  # no phase shift: the filtered peak where the signal's is
+            assert np.max(np.abs(y[mid] - expected * x[mid])) < 2e-3
+
+
+def test_sliding_mean_scales_a_harmonic_by_the_window_sinc():
+    """A7: a harmonic of wavelength L averaged over w = 2 m keeps sin(pi w/L)/(pi w/L) of its
+    amplitude, at every window centre (the integral of a piecewise-linear signal, exact up to the
+    sampling of the harmonic)."""
+    s = np.linspace(0.0, 100.0, 20001)
+    for L in (3.0, 10.0, 37.0):
+        x = np.cos(2 * np.pi * s / L)
+        c, m = sliding_mean(s, x)
+        k = np.pi * 2.0 / L
+        assert np.allclose(m, np.sin(k) / k * np.cos(2 * np.pi * c / L), atol=1e-6)
+        assert c[0] == pytest.approx(1.0) and np.all(np.diff(c) == pytest.approx(0.5))
+
+
+def test_sliding_mean_of_a_constant_and_a_ramp_on_an_uneven_grid():
+    s = np.sort(np.random.default_rng(3).uniform(0.0, 30.0, 400))
+    c, m = sliding_mean(s, 3.0 + 0.0 * s)
+    assert np.allclose(m, 3.0, rtol=1e-12)
+    c, m = sliding_mean(s, 2.0 * s)  # the mean of a ramp over a centred window is its centre value
+    assert np.allclose(m, 2.0 * c, rtol=1e-12)
+
+
+def test_sliding_mean_and_lowpass_name_bad_input():
+    with pytest.raises(InputError, match="must increase"):
+        sliding_mean(np.array([0.0, 1.0, 1.0, 3.0]), np.zeros(4))
+    with pytest.raises(InputError, match="shorter than the window"):
+        sliding_mean(np.array([0.0, 1.0]), np.zeros(2))
+    with pytest.raises(InputError, match="Nyquist"):
+        lowpass(np.zeros(100), fs=30.0)
+    with pytest.raises(InputError, match="not finite"):
+        lowpass(np.array([0.0, np.nan] * 50), fs=1000.0)
+
+
+def test_wheel_force_statistics_of_a_bouncing_wheel():
+    """A wheel load of 54.5 kN with a 2 Hz swing of 5 kN and a 200 Hz bounce of 20 kN, at 1 kHz:
+    the 20 Hz low-pass keeps the swing (gain 1 - 1e-8) and removes the bounce, so the 99.85 %
+    percentile of Q is 54.5 + 5 sin(pi (0.9985 - 1/2)) kN (the quantile of a sinusoid); the
+    unfiltered maximum is about 54.5 + 25 kN; Y = 0.1 Q gives (Y/Q) 2 m = 0.1."""
+    import pandas as pd
+
+    fs, V = 1000.0, 20.0
+    t = np.arange(0.0, 10.0, 1.0 / fs)
+    Q = 54.5e3 + 5e3 * np.sin(2 * np.pi * 2.0 * t) + 20e3 * np.sin(2 * np.pi * 200.0 * t + 0.3)
+    Y = 0.1 * (54.5e3 + 5e3 * np.sin(2 * np.pi * 2.0 * t))
+    H = pd.DataFrame({"t [s]": t, "wheel": "ws1 left", "wheelset": "ws1", "s [m]": V * t,
+                      "Q [N]": Q, "Y [N]": Y, "sum Y [N]": Y})
+    W = wheel_force_statistics(H)
+    assert len(W) == 1
+    r = W.iloc[0]
+    # the filter's end transients lie outside the percentile's 0.15 %: 15 ms at each end
+    assert r["Q high [N]"] == pytest.approx(54.5e3 + 5e3 * np.sin(np.pi * 0.4985), rel=1e-4)
+    assert r["Q low [N]"] == pytest.approx(54.5e3 - 5e3 * np.sin(np.pi * 0.4985), rel=1e-4)
+    assert r["Q max, unfiltered [N]"] == pytest.approx(54.5e3 + 25e3, rel=2e-3)
+    assert r["(Y/Q) 2 m high [-]"] == pytest.approx(0.1, rel=1e-3)
+    # sum Y: 2 m window at 20 m/s is 0.1 s; the 2 Hz swing (L = 10 m) keeps sinc(pi/5) of its amplitude
+    k = np.pi * 2.0 / 10.0
+    q = np.sin(np.pi * 0.4985)
+    assert r["(sum Y) 2 m high [N]"] == pytest.approx(0.1 * (54.5e3 + 5e3 * np.sin(k) / k * q), rel=2e-3)

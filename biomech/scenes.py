@@ -268,7 +268,7 @@ def _run_muscle_forces(ctx):
         f"included; moment arms -dL/dq of the paths with their via, conditional and moving points) and the reserve "
         f"actuators of gait10dof_Reserve_Actuators.xml (optimal force 1 N m: expensive; the pelvis residuals FX, FY, MZ "
         f"on the pelvis coordinates), activations in [0, 1]; one cvxpy problem with parameters per model, solved by "
-        f"Clarabel (native power cones for the cubic criterion). Frames not 'optimal': "
+        f"Clarabel (the cubic criterion's powers as exact second-order cones through cvxpy's power atom, the default; Clarabel's native power cones with epigraph='power_cone'). Frames not 'optimal': "
         f"{', '.join(f'{k}: {v}' for k, v in n_bad.items())} (per-frame status table). The lumbar extension moment "
         f"and the pelvis residuals are carried by reserves alone (no muscle spans them in this model). "
         + ("OpenSim 4.6's static optimization (sum a^2, its Millard 2012 muscle curves, passive force left out, "

@@ -51,11 +51,12 @@ frame only changes parameter values and reuses the compiled problem data:
 * the stress criterion adds parameters c, d >= 0 (n) with s = c ∘ a + d;
 * a power term :math:`\sum x^p` with p = 2 and x a variable is ``sum_squares`` (Clarabel takes
   the quadratic objective natively); p = 1 is a sum (``norm1`` for the signed reserves); every other
-  case is the epigraph :math:`t_k \ge |x_k|^p` written as Clarabel's native 3-D power cone
-  ``PowCone3D(t, 1, x, 1/p)`` (:math:`t^{1/p} 1^{1 - 1/p} \ge |x|`), objective :math:`\sum t_k`.
-  ``cp.power(s, 3)`` is rewritten by cvxpy into second-order cones (exact for p = 3), which the
-  project notes found to return 'optimal_inaccurate' on some frames with 43 and 92 muscles; it is
-  available as ``epigraph="soc"``.  On the synthetic frames of this project's tests and benchmark
+  case is, by default (``epigraph="soc"``), ``cp.power(s, p)``, which cvxpy rewrites into
+  second-order cones (exact for p = 3; the project notes had found it 'optimal_inaccurate' on some
+  frames with 43 and 92 muscles, but on the gait trials it ended 'optimal' on every feasible frame,
+  README), or, with ``epigraph="power_cone"``, the epigraph :math:`t_k \ge |x_k|^p` as Clarabel's
+  native 3-D power cone ``PowCone3D(t, 1, x, 1/p)`` (:math:`t^{1/p} 1^{1 - 1/p} \ge |x|`),
+  objective :math:`\sum t_k` (it left one gait2392 frame as a solver error after the retries).  On the synthetic frames of this project's tests and benchmark
   both forms end 'optimal' on (nearly) every frame at the first attempt, each occasionally needing
   a retry; the SOC form meets the moment equations more tightly (residual ~1e-12 against ~1e-9 N m).
   On the real trials the SOC form is the more robust one, so it is the default: gait2392 (92

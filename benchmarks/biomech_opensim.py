@@ -143,7 +143,10 @@ def main(argv=None):
         rows.append(row)
     table = pd.DataFrame(rows)
     RESULTS.mkdir(exist_ok=True)
-    head = (f"# Gait inverse dynamics and static optimisation beside OpenSim\n\nLoad average at the start: {load:.2f} "
+    from _host import host_line
+
+    head = (f"# Gait inverse dynamics and static optimisation beside OpenSim\n\nHost: {host_line()}.\n\n"
+            f"Load average at the start: {load:.2f} "
             f"(2 cores); best of {args.repeats} runs after a warm-up; OpenSim "
             f"{opensim_peer.version() if peer else 'not installed'}.\n\n")
     (RESULTS / "biomech_opensim.md").write_text(head + table.to_markdown(index=False, floatfmt=".4g") + "\n")

@@ -377,10 +377,12 @@ def main(argv=None) -> int:
 
     have_exudyn = exc.load_exudyn() is not None
     import scipy
+    from _host import cpu_model
 
     log(f"peer_chain: python {platform.python_version()}, numpy {np.__version__}, scipy {scipy.__version__}, "
         f"exudyn {sys.modules['exudyn'].__version__ if have_exudyn else '-'}, "
-        f"machine {platform.machine()} ({os.cpu_count()} cores), load average at start {os.getloadavg()[0]:.2f}")
+        f"machine {platform.machine()} ({os.cpu_count()} cores), {cpu_model()}, "
+        f"load average at start {os.getloadavg()[0]:.2f}")
     if not have_exudyn:
         log(EXUDYN_MISSING)
     log(f"tools: {', '.join(tools)}")

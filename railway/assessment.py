@@ -63,9 +63,9 @@ squared)::
     |H(f)| = 1 / (1 + (tan(pi f / f_s) / tan(pi f_c / f_s))^(2n))                        (A6)
 
 (1/2 at the cut-off; the same filter as :func:`biomech.kinematics.lowpass_filter`, which adds
-OpenSim's padding).
-
-and the sliding mean over a window w of distance s (x linear between the samples)::
+OpenSim's padding).  The order n = 4 per pass is this project's choice: the quoted source gives
+the cut-off, not the filter.  The sliding mean over a window w of distance s (x linear between
+the samples)::
 
     x_w(s) = (1/w) int_{s - w/2}^{s + w/2} x(s') ds'                                     (A7)
 

@@ -390,8 +390,8 @@ def lowpass(x, fs, cutoff=CUTOFF_HZ, order=FILTER_ORDER):
     x = np.asarray(x, dtype=float)
     _finite("x", x, "lowpass")
     if not (0.0 < cutoff < 0.5 * fs):
-        raise InputError(f"lowpass: cut-off {cutoff!r} Hz must lie between 0 and the Nyquist frequency "
-                         f"fs/2 = {0.5 * fs!r} Hz")
+        raise InputError(f"lowpass: cut-off {float(cutoff)!r} Hz must lie between 0 and the Nyquist frequency "
+                         f"fs/2 = {0.5 * float(fs)!r} Hz")
     sos = butter(order, cutoff, btype="low", fs=fs, output="sos")
     return sosfiltfilt(sos, x, axis=-1)
 
@@ -410,9 +410,9 @@ def sliding_mean(s, x, window=WINDOW_M, step=SAMPLING_M):
         raise InputError(f"sliding_mean: s has shape {s.shape}, x {x.shape}: need s (n,) and x (..., n)")
     if np.any(np.diff(s) <= 0.0):
         i = int(np.argmax(np.diff(s) <= 0.0))
-        raise InputError(f"sliding_mean: s must increase; s[{i}] = {s[i]!r} m, s[{i + 1}] = {s[i + 1]!r} m")
+        raise InputError(f"sliding_mean: s must increase; s[{i}] = {float(s[i])!r} m, s[{i + 1}] = {float(s[i + 1])!r} m")
     if s[-1] - s[0] < window:
-        raise InputError(f"sliding_mean: {s[-1] - s[0]!r} m of signal is shorter than the window {window!r} m")
+        raise InputError(f"sliding_mean: {float(s[-1] - s[0])!r} m of signal is shorter than the window {window!r} m")
     centres = np.arange(s[0] + 0.5 * window, s[-1] - 0.5 * window + 1e-9 * window, step)
     # exact integral of the piecewise-linear signal: cumulative trapezoids, interpolated at the ends
     cum = np.concatenate([np.zeros(x.shape[:-1] + (1,)),
@@ -446,7 +446,7 @@ def wheel_force_statistics(H, cutoff=CUTOFF_HZ, window=WINDOW_M, step=SAMPLING_M
     dt = np.diff(t)
     if np.ptp(dt) > 1e-6 * dt.mean():
         raise InputError("wheel_force_statistics: the output times must be uniformly spaced "
-                         f"(steps from {dt.min()!r} to {dt.max()!r} s)")
+                         f"(steps from {float(dt.min())!r} to {float(dt.max())!r} s)")
     fs = 1.0 / dt.mean()
     lo, hi = percentiles
     rows = []
@@ -454,6 +454,12 @@ def wheel_force_statistics(H, cutoff=CUTOFF_HZ, window=WINDOW_M, step=SAMPLING_M
         g = g.sort_values("t [s]")
         s = g["s [m]"].to_numpy()
         Q, Y, SY = (g[c].to_numpy() for c in ("Q [N]", "Y [N]", "sum Y [N]"))
+        for name, x in (("Q [N]", Q), ("Y [N]", Y), ("sum Y [N]", SY)):
+            bad = ~np.isfinite(x)
+            if bad.any():
+                k = int(np.argmax(bad))
+                raise InputError(f"wheel_force_statistics: wheel {wheel!r}: {name} = {float(x[k])!r} at "
+                                 f"t = {float(g['t [s]'].iloc[k])!r} s is not finite")
         Qf, Yf, SYf = lowpass(np.vstack([Q, Y, SY]), fs, cutoff)
         with np.errstate(invalid="ignore", divide="ignore"):
             yq = np.where(Qf > 0.0, Yf / Qf, np.nan)

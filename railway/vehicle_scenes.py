@@ -658,6 +658,8 @@ def irregular_case(case):
 
     from .track import Track
     from .vehicle import GRAVITY, VehicleDefinition, build_vehicle
+    from core.errors import InputError
+
     from .assessment import wheel_force_statistics
     from .wheel_rail import contact_history
 
@@ -687,8 +689,15 @@ def irregular_case(case):
     # carries the wheelsets' bounce are samples of that oscillation, not a statistic
     H = contact_history(veh.model, res)
     H = H[H["t [s]"] >= t_skip]
-    W = wheel_force_statistics(H)
     Q0 = D.total_mass * GRAVITY / 8.0
+    try:
+        W = wheel_force_statistics(H)
+        note = ""
+    except InputError as exc:  # e.g. a run that failed before a 2 m window of signal: keep its row
+        cols = ["Q high [N]", "Q low [N]", "Q max, unfiltered [N]", "Q min, unfiltered [N]", "|Y| high [N]",
+                "(Y/Q) 2 m high [-]", "(sum Y) 2 m high [N]"]
+        W = pd.DataFrame([{c: np.nan for c in cols}])
+        note = f"no wheel-force statistics: {exc}"
     row = {"speed [m/s]": V, "creep law": law, "status": res.status,
            "car body lateral acceleration rms [m/s2]": float(np.sqrt(np.mean(acc_y[keep] ** 2))),
            "car body vertical acceleration rms [m/s2]": float(np.sqrt(np.mean(acc_z[keep] ** 2))),
@@ -700,7 +709,8 @@ def irregular_case(case):
            "Q min, unfiltered [N]": float(W["Q min, unfiltered [N]"].min()),
            "|Y| high, 20 Hz [N]": float(W["|Y| high [N]"].max()),
            "(Y/Q) 2 m high [-]": float(W["(Y/Q) 2 m high [-]"].max()),
-           "(sum Y) 2 m high [N]": float(W["(sum Y) 2 m high [N]"].max()), "n_rhs": res.counters["n_rhs"]}
+           "(sum Y) 2 m high [N]": float(W["(sum Y) 2 m high [N]"].max()), "n_rhs": res.counters["n_rhs"],
+           "message": "; ".join(m for m in (res.message if not res.success else "", note) if m)}
     return row, (f, Py, Pz)
 
 

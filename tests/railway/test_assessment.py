@@ -250,3 +250,18 @@ def test_wheel_force_statistics_of_a_bouncing_wheel():
     k = np.pi * 2.0 / 10.0
     q = np.sin(np.pi * 0.4985)
     assert r["(sum Y) 2 m high [N]"] == pytest.approx(0.1 * (54.5e3 + 5e3 * np.sin(k) / k * q), rel=2e-3)
+
+
+def test_wheel_force_statistics_name_the_wheel_and_time_of_a_bad_sample():
+    import pandas as pd
+
+    t = np.arange(0.0, 1.0, 1e-3)
+    H = pd.DataFrame({"t [s]": t, "wheel": "ws2 right", "wheelset": "ws2", "s [m]": 20.0 * t,
+                      "Q [N]": 5e4 + 0.0 * t, "Y [N]": 0.0 * t, "sum Y [N]": 0.0 * t})
+    H.loc[500, "Q [N]"] = np.nan
+    with pytest.raises(InputError, match=r"wheel 'ws2 right': Q \[N\] = nan at t = 0\.5"):
+        wheel_force_statistics(H)
+    short = H.iloc[:50].copy()  # 50 ms at 20 m/s: 1 m of track, shorter than the 2 m window
+    short["Q [N]"] = 5e4
+    with pytest.raises(InputError, match="shorter than the window"):
+        wheel_force_statistics(short)

@@ -127,6 +127,7 @@ import pandas as pd
 
 from core.errors import DataFileError, InputError, ModelError, UnknownOptionError
 
+from .checks import RANGES, check_value, checked_options, name_hint
 from .functions import Constant, LinearFunction
 from .osim import Body, Joint, OffsetFrame, OsimModel, TransformAxis
 
@@ -165,6 +166,10 @@ _SEGMENTS = ("HAT", "thigh", "shank", "foot")
 # =============================================================================================
 # reading the tables
 # =============================================================================================
+
+
+def _fmt(x: float) -> str:
+    return f"{float(x):.4g}"
 
 
 def _default_path(name: str) -> Path:
@@ -417,8 +422,9 @@ def _deleva_hat(tab: pd.DataFrame, L_hat: float, rg_col: str):
     return m, sG, math.sqrt(IG / m)
 
 
+@checked_options
 def segment_parameters(mass, stature=None, table="deleva", segment_lengths=None, *,
-                       deleva_rg="transverse") -> pd.DataFrame:
+                       deleva_rg="transverse", accept=()) -> pd.DataFrame:
     r"""Mass, centre of mass and moment of inertia of the HAT, thigh, shank and foot.
 
     .. math::
@@ -429,10 +435,10 @@ def segment_parameters(mass, stature=None, table="deleva", segment_lengths=None,
 
     Parameters
     ----------
-    mass : float
-        Body mass M [kg].
-    stature : float, optional
-        [m].  de Leva only: segment lengths are the table's male means × stature / 1.741 m.
+    mass : float or str
+        Body mass M [kg] (a string with its unit, ``"160 lb"``, is converted); plausible 20-250 kg.
+    stature : float or str, optional
+        [m] (or a string with its unit, ``"175 cm"``); plausible 0.9-2.3 m.  de Leva only: segment lengths are the table's male means × stature / 1.741 m.
     table : {"deleva", "winter"}
     segment_lengths : mapping, optional
         Measured lengths [m] of ``"HAT"`` (de Leva: mid-hip to vertex; Winter: greater trochanter to
@@ -442,6 +448,9 @@ def segment_parameters(mass, stature=None, table="deleva", segment_lengths=None,
     deleva_rg : {"transverse", "sagittal"}
         Which de Leva radius of gyration is used for rotation in the sagittal plane: about the
         medio-lateral (transverse) axis (default, module docstring) or the antero-posterior one.
+    accept : sequence of str
+        Plausible-range quantities not to enforce (``"body_mass"``, ``"stature"``,
+        ``"body_mass_index"``, ``"segment_length"``; ``data/biomech/plausible_ranges.csv``).
 
     Returns
     -------
@@ -458,6 +467,9 @@ def segment_parameters(mass, stature=None, table="deleva", segment_lengths=None,
         A non-positive mass, stature or length; no way to get a length (Winter without measured
         lengths); an unknown table; :class:`core.errors.UnknownOptionError` for an unknown
         segment in ``segment_lengths`` or an unknown ``deleva_rg``.
+    core.inputs.ImplausibleValueError
+        A body mass, stature or segment length outside its plausible range (in grams, pounds, cm,
+        mm: the slip is named), or a body-mass index outside 13-45 kg/m² (a mass in pounds).
 
     Examples
     --------
@@ -465,18 +477,35 @@ def segment_parameters(mass, stature=None, table="deleva", segment_lengths=None,
     >>> round(float(p.loc["HAT", "mass [kg]"] + 2 * p.loc[["thigh", "shank", "foot"], "mass [kg]"].sum()), 6)
     72.6
     """
-    M = float(mass)
+    from core.inputs import parse_quantity
+
+    accept = tuple([accept] if isinstance(accept, str) else accept)
+    M = parse_quantity(mass, "kg", where="segment_parameters(mass=...)")
     if not (math.isfinite(M) and M > 0):
         raise InputError(f"body mass must be a positive number of kg, got {mass!r}")
-    if stature is not None and not (math.isfinite(float(stature)) and float(stature) > 0):
-        raise InputError(f"stature must be a positive number of metres, got {stature!r}")
+    M = check_value("body_mass", mass, where="segment_parameters(mass=...)", accept=accept)
+    if stature is not None:
+        h = parse_quantity(stature, "m", where="segment_parameters(stature=...)")
+        if not (math.isfinite(h) and h > 0):
+            raise InputError(f"stature must be a positive number of metres, got {stature!r}")
+        stature = check_value("stature", stature, where="segment_parameters(stature=...)", accept=accept)
+        bmi = M / stature ** 2
+        lb = M * 0.45359237
+        rng = RANGES["body_mass_index"]
+        hint = (f"a body mass in pounds ({_fmt(M)} lb = {_fmt(lb)} kg, body-mass index {_fmt(lb / stature ** 2)})?"
+                if not rng.contains(bmi) and rng.contains(lb / stature ** 2) else "")
+        check_value("body_mass_index", bmi,
+                    where=f"segment_parameters(mass={_fmt(M)} kg, stature={_fmt(stature)} m)", accept=accept, hint=hint)
     given = dict(segment_lengths or {})
     unknown = [k for k in given if k not in _SEGMENTS]
     if unknown:
-        raise UnknownOptionError(f"segment_lengths: unknown segment(s) {unknown}; accepted: {list(_SEGMENTS)}")
+        raise UnknownOptionError(f"segment_lengths: unknown segment(s) {unknown}"
+                                 f"{name_hint(unknown[0], _SEGMENTS)} (accepted: {list(_SEGMENTS)})")
     for k, v in given.items():
-        if not (math.isfinite(float(v)) and float(v) > 0):
+        v_si = parse_quantity(v, "m", where=f"segment_lengths[{k!r}]")
+        if not (math.isfinite(v_si) and v_si > 0):
             raise InputError(f"segment_lengths[{k!r}] must be a positive length in metres, got {v!r}")
+        given[k] = check_value("segment_length", v, where=f"segment_parameters(segment_lengths[{k!r}])", accept=accept)
     if table == "deleva":
         if deleva_rg not in ("transverse", "sagittal"):
             raise UnknownOptionError(f"deleva_rg must be 'transverse' or 'sagittal', got {deleva_rg!r}")
@@ -514,7 +543,8 @@ def segment_parameters(mass, stature=None, table="deleva", segment_lengths=None,
             prox, dist = (x.strip() for x in tab.at[row, "endpoints"].split("/", 1))
             rows[s] = (tab.at[row, "mass_fraction"], tab.at[row, "com_from_proximal"], tab.at[row, rg_col], prox, dist)
     else:
-        raise InputError(f"unknown anthropometric table {table!r}; use 'deleva' or 'winter'")
+        raise InputError(f"unknown anthropometric table {table!r}{name_hint(str(table), ['deleva', 'winter'])} "
+                         f"(use 'deleva' or 'winter')")
     out = {}
     for s in _SEGMENTS:
         P, c, r, prox, dist = rows[s]
@@ -566,6 +596,7 @@ def _planar_joint_motion(joint: Joint, q: np.ndarray, where: str):
     return phi, t
 
 
+@checked_options
 def fit_pin_centre(joint: Joint, q_range, n: int = 261, where: str = ""):
     r"""The fixed centre that best reproduces a one-coordinate planar joint's motion.
 
@@ -691,6 +722,7 @@ def _body(name, mass, com2, Izz):
 # =============================================================================================
 
 
+@checked_options
 def anthropometric_sagittal_model(osim_reference, table="deleva", *, hat_body="torso", deleva_rg="transverse",
                                   knee_fit_range=None, markers=None, name=None) -> OsimModel:
     """A planar gait model with the reference's joints and the table's segment inertias.
@@ -744,7 +776,8 @@ def anthropometric_sagittal_model(osim_reference, table="deleva", *, hat_body="t
     ref = osim_reference
     where = ref.path or ref.name
     if table not in ("deleva", "winter"):
-        raise InputError(f"unknown anthropometric table {table!r}; use 'deleva' or 'winter'")
+        raise InputError(f"unknown anthropometric table {table!r}{name_hint(str(table), ['deleva', 'winter'])} "
+                         f"(use 'deleva' or 'winter')")
     if hat_body not in ("torso", "pelvis"):
         raise InputError(f"hat_body must be 'torso' or 'pelvis', got {hat_body!r}")
     mk = dict(DEFAULT_MARKERS)
@@ -895,6 +928,7 @@ def anthropometric_sagittal_model(osim_reference, table="deleva", *, hat_body="t
 # =============================================================================================
 
 
+@checked_options
 def moment_differences(reference: pd.DataFrame, other: pd.DataFrame, coordinates=None, window=None) -> pd.DataFrame:
     """Root-mean-square and peak differences of two inverse-dynamics results.
 

@@ -39,7 +39,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from core.errors import DataRangeError, InputError
+from core.errors import DataRangeError, InputError, ModelError
+
+from .checks import check_value, check_window, checked_options, ranges, warn_sampling
+from .kinematics import check_cutoff
 
 __all__ = ["GaitTrial", "load_trial", "inverse_dynamics", "gait_events"]
 
@@ -59,7 +62,8 @@ class GaitTrial:
         return float(sum(b.mass for b in self.osim.bodies))
 
 
-def load_trial(model_file, motion_file, external_loads_file, window=None, cutoff=6.0, order=3):
+@checked_options
+def load_trial(model_file, motion_file, external_loads_file, window=None, cutoff=6.0, order=3, *, accept=()):
     """Read and process a trial (steps 1–3 of the module docstring).
 
     Parameters
@@ -74,28 +78,64 @@ def load_trial(model_file, motion_file, external_loads_file, window=None, cutoff
     order : int
         Butterworth order per pass: 3 (default) is OpenSim's 3rd-order IIR run forward and
         backward (6th order, zero lag); 2 gives the common 4th-order zero-lag filter.
+    accept : sequence of str
+        Plausible-range quantities not to enforce (``data/biomech/plausible_ranges.csv``), passed on
+        to the readers.
+
+    Raises
+    ------
+    core.inputs.ImplausibleValueError
+        A value outside its plausible range (file, column or argument named, with the likely
+        slip): segment masses, muscle parameters, translations, centre of pressure, ground
+        reactions, the cut-off, the sampling rates (a time column in ms), the model's mass against
+        the ground reactions (peak vertical reaction 0.7-6 body weights: a mass in pounds or grams).
+    core.errors.DataRangeError
+        A window outside the data's time range (per cent of the gait cycle or ms named as such).
+    core.errors.ModelError
+        An external force applied to (or expressed in) a body the model lacks (closest named).
+
+    Warns
+    -----
+    biomech.checks.SamplingRateWarning
+        Force data sampled more coarsely than the kinematics.
     """
     from .kinematics import process_coordinates
     from .osim import OsimModel, read_osim
     from .storage import check_motion_against_model, read_external_loads, read_storage, resample_external_loads
 
-    osim = model_file if isinstance(model_file, OsimModel) else read_osim(model_file)
-    motion = read_storage(motion_file, model=osim)
+    accept = tuple([accept] if isinstance(accept, str) else accept)
+    if order not in (1, 2, 3, 4, 5, 6, 7, 8, 9, 10) or isinstance(order, bool):
+        raise InputError(f"load_trial(order={order!r}): the Butterworth order per pass must be an integer 1..10")
+    if cutoff is not None:
+        cutoff = check_cutoff(cutoff, where="load_trial(cutoff=...)", accept=accept)
+    osim = model_file if isinstance(model_file, OsimModel) else read_osim(model_file, accept=accept)
+    where_model = str(model_file) if not isinstance(model_file, OsimModel) else f"model {osim.name!r}"
+    check_value("body_mass", osim.total_mass, where=f"{where_model}: total mass of the bodies", accept=accept)
+    motion = read_storage(motion_file, model=osim, accept=accept)
     check_motion_against_model(motion, osim, source=str(motion_file))
-    loads = read_external_loads(external_loads_file)
+    loads = read_external_loads(external_loads_file, accept=accept)
+    _check_loads_against_model(loads, osim)
     tm = motion["time"].to_numpy(float)
+    fs_k = _rate(tm)
+    fs_f = _rate(loads.time)
+    for quantity, fs, src in (("coordinate_sample_rate", fs_k, motion_file), ("force_sample_rate", fs_f, loads.source)):
+        lowest = ranges()[quantity].low
+        hint = ("the time column looks like milliseconds or frame numbers; times must be in seconds"
+                if fs < lowest else "")
+        check_value(quantity, fs, where=f"{src}: time column", accept=accept, hint=hint)
+    if fs_f < fs_k * (1 - 1e-6):
+        warn_sampling(f"{loads.source} is sampled at {fs_f:.6g} Hz, more coarsely than the kinematics {motion_file} "
+                      f"({fs_k:.6g} Hz): the ground reactions are interpolated between their samples and impacts "
+                      f"are smoothed (force plates are normally sampled 5-20 times faster)")
+    _check_body_weight(loads, osim, where_model, accept)
     lo, hi = max(tm[0], loads.time[0]), min(tm[-1], loads.time[-1])
-    if window is not None:
-        lo_w, hi_w = map(float, window)
-        if lo_w < lo - 1e-9 or hi_w > hi + 1e-9:
-            raise DataRangeError(f"window [{lo_w:g}, {hi_w:g}] s is outside the range covered by both "
-                                 f"{motion_file} ({tm[0]:g}-{tm[-1]:g} s) and {loads.source} "
-                                 f"({loads.time[0]:g}-{loads.time[-1]:g} s)")
-        lo, hi = lo_w, hi_w
     if hi <= lo:
         raise DataRangeError(f"{motion_file} ({tm[0]:g}-{tm[-1]:g} s) and {loads.source} "
                              f"({loads.time[0]:g}-{loads.time[-1]:g} s) do not overlap")
-    kin = process_coordinates(motion, cutoff=cutoff, order=order)  # filtered over the whole record
+    if window is not None:
+        lo, hi = check_window(window, lo, hi, where=f"load_trial: {motion_file} ({tm[0]:g}-{tm[-1]:g} s) and "
+                                                    f"{loads.source} ({loads.time[0]:g}-{loads.time[-1]:g} s) together")
+    kin = process_coordinates(motion, cutoff=cutoff, order=order, accept=accept)  # filtered over the whole record
     keep = (tm >= lo - 1e-9) & (tm <= hi + 1e-9)
 
     class _K:  # the processed kinematics restricted to the window
@@ -110,6 +150,58 @@ def load_trial(model_file, motion_file, external_loads_file, window=None, cutoff
                      dict(cutoff_hz=cutoff, order_per_pass=order,
                           model=(osim.path or osim.name) if osim is model_file else str(model_file),
                           motion=str(motion_file), external_loads=str(external_loads_file)))
+
+
+def _rate(t: np.ndarray) -> float:
+    dt = np.diff(np.asarray(t, float))
+    return 1.0 / float(np.median(dt)) if dt.size else float("nan")
+
+
+def _check_loads_against_model(loads, osim) -> None:
+    """Every external force acts on, and is expressed in, a body of the model (or ground)."""
+    from .checks import name_hint
+
+    names = [b.name for b in osim.bodies] + [osim.ground]
+    for f in loads.spec.forces:
+        for what, body in (("applied_to_body", f.applied_to_body), ("force_expressed_in_body", f.force_expressed_in_body),
+                           ("point_expressed_in_body", f.point_expressed_in_body)):
+            if body not in names:
+                raise ModelError(f"{loads.spec.path}: external force {f.name!r}: {what} {body!r} is not a body of model "
+                                 f"{osim.name!r}{name_hint(body, names)}")
+
+
+def _check_body_weight(loads, osim, where_model: str, accept) -> None:
+    """The peak vertical ground reaction, in body weights of the model's mass, must be plausible."""
+    from core.inputs import ImplausibleValueError
+
+    if "grf_body_weights" in accept:
+        return
+    g = np.asarray(osim.gravity, float)
+    gn = float(np.linalg.norm(g))
+    acting = [f for f in loads.forces if f.spec.applies_force]
+    if gn == 0 or not acting or osim.total_mass <= 0:
+        return
+    up = -g / gn
+    fv = np.sum([np.asarray(f.force, float) @ up for f in acting], axis=0)
+    peak = float(np.max(fv))
+    if not peak > 0:
+        return
+    mass = float(osim.total_mass)
+    bw = peak / (mass * gn)
+    r = ranges()["grf_body_weights"]
+    if r.contains(bw):
+        return
+    if bw < r.low:
+        cause = (f"the model's mass is too large for these forces: a mass in pounds ({mass:.4g} lb = "
+                 f"{mass * 0.45359237:.4g} kg)?" if r.contains(bw / 0.45359237) else
+                 "the forces are too small for the model's mass (forces scaled, or the mass in another unit?)")
+    else:
+        cause = "the forces are too large for the model's mass (segment masses missing, forces in another unit, or a " \
+                "wrong model?)"
+    raise ImplausibleValueError(
+        f"{loads.source}: the peak vertical ground reaction {peak:.4g} N is {bw:.3g} body weights of {where_model}'s "
+        f"{mass:.4g} kg, outside the plausible range {r.describe()}: {cause} (to use it deliberately, "
+        f"accept='grf_body_weights')", "grf_body_weights", bw, cause)
 
 
 def inverse_dynamics(trial: GaitTrial) -> pd.DataFrame:
@@ -154,6 +246,7 @@ def inverse_dynamics(trial: GaitTrial) -> pd.DataFrame:
     return out
 
 
+@checked_options
 def gait_events(loads, body, threshold=20.0):
     """Heel strikes and toe-offs of the foot ``body`` from its vertical ground reaction force.
 
@@ -173,4 +266,7 @@ def gait_events(loads, body, threshold=20.0):
                 return t[i] + (threshold - Fy[i]) * (t[i + 1] - t[i]) / (Fy[i + 1] - Fy[i])
 
             return np.array([cross(i) for i in up]), np.array([cross(i) for i in dn])
-    raise InputError(f"no external force acts on {body!r}")
+    from .checks import name_hint
+
+    bodies = [f.spec.applied_to_body for f in loads.forces]
+    raise InputError(f"no external force acts on {body!r} (they act on {bodies}){name_hint(str(body), bodies)}")

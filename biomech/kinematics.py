@@ -63,12 +63,17 @@ from scipy.signal import butter, sosfiltfilt
 
 from core.errors import InputError
 
+from core.inputs import parse_quantity
+
+from .checks import check_value, checked_options, name_hint
+
 __all__ = [
     "CoordinateKinematics",
     "butterworth_gain",
     "odd_reflection_pad",
     "lowpass_filter",
     "process_coordinates",
+    "check_cutoff",
 ]
 
 
@@ -117,6 +122,7 @@ def _sample_rate(t: np.ndarray, label: str) -> float:
     return 1.0 / h
 
 
+@checked_options
 def lowpass_filter(values, sample_rate: float, cutoff: float = 6.0, order: int = 2, *,
                    pad: int | None = None, label: str = "signal") -> np.ndarray:
     """Zero-lag low-pass Butterworth filter (see the module docstring for the equations).
@@ -158,9 +164,22 @@ def lowpass_filter(values, sample_rate: float, cutoff: float = 6.0, order: int =
 def _check_filter(cutoff, sample_rate, order, label):
     if not (isinstance(order, (int, np.integer)) and not isinstance(order, bool) and 1 <= order <= 10):
         raise InputError(f"{label}: filter order must be an integer 1..10, got {order!r}")
+    if isinstance(cutoff, bool) or not isinstance(cutoff, (int, float, np.integer, np.floating)):
+        raise InputError(f"{label}: cut-off {cutoff!r} must be a number of Hz")
     if not (np.isfinite(cutoff) and 0 < cutoff < 0.5 * sample_rate * (1 - 1e-6)):  # margin: fs from rounded times
         raise InputError(f"{label}: cut-off {cutoff!r} Hz must lie between 0 and the Nyquist frequency "
-                         f"{0.5 * sample_rate:g} Hz")
+                         f"{0.5 * sample_rate:g} Hz (half the sampling rate {sample_rate:.6g} Hz)")
+
+
+def check_cutoff(cutoff: float, *, where: str = "cutoff", accept: Sequence[str] = ()) -> float:
+    """Refuse a low-pass cut-off outside the plausible range of gait kinematics (2-30 Hz).
+
+    A cut-off below 1 names the likely slip of a normalised frequency (a fraction of the Nyquist
+    frequency, as ``scipy.signal.butter`` takes without ``fs``).
+    """
+    value = parse_quantity(cutoff, "Hz", where=where)
+    hint = "a cut-off normalised by the Nyquist frequency (scipy's Wn)? give it in Hz" if 0 < value < 1 else ""
+    return check_value("filter_cutoff", cutoff, where=where, accept=accept, hint=hint)
 
 
 @dataclass(frozen=True, eq=False)
@@ -194,8 +213,10 @@ def _natural_bc(k: int, trailing_shape: tuple[int, ...]):
     return (cond, cond)
 
 
+@checked_options
 def process_coordinates(motion: pd.DataFrame, *, cutoff: float | None = 6.0, order: int = 2,
-                        spline_degree: int = 5, columns: Sequence[str] | None = None) -> CoordinateKinematics:
+                        spline_degree: int = 5, columns: Sequence[str] | None = None,
+                        accept: Sequence[str] = ()) -> CoordinateKinematics:
     """Filter coordinates and differentiate them as OpenSim's inverse-dynamics tool does.
 
     Parameters
@@ -203,14 +224,18 @@ def process_coordinates(motion: pd.DataFrame, *, cutoff: float | None = 6.0, ord
     motion : DataFrame
         ``time`` column [s] and coordinate columns in SI units (from
         :func:`biomech.storage.read_storage`); uniformly sampled when filtering.
-    cutoff : float or None
-        Low-pass cut-off f_c [Hz] (default 6); None: no filtering and no padding.
+    cutoff : float, str or None
+        Low-pass cut-off f_c [Hz] (default 6; a string with its unit, ``"6 Hz"``, is converted);
+        None: no filtering and no padding.
     order : int
         Butterworth order per pass (default 2, 4th order effective; OpenSim uses 3).
     spline_degree : {3, 5}
         Degree of the interpolating natural spline used for the derivatives (default 5, as OpenSim).
     columns : sequence of str, optional
         Coordinates to process (default: all columns but ``time``).
+    accept : sequence of str
+        ``["filter_cutoff"]`` lets a cut-off outside the plausible 2-30 Hz of gait kinematics
+        through (``data/biomech/plausible_ranges.csv``).
 
     Returns
     -------
@@ -222,6 +247,8 @@ def process_coordinates(motion: pd.DataFrame, *, cutoff: float | None = 6.0, ord
     core.errors.InputError
         No ``time`` column, unknown columns, NaN values, non-uniform sampling (when filtering),
         a cut-off at or above the Nyquist frequency, too few samples for the spline.
+    core.inputs.ImplausibleValueError
+        A cut-off outside 2-30 Hz (typical for gait: 4-20 Hz), e.g. 0.06 Hz.
     """
     if "time" not in motion.columns:
         raise InputError("motion has no 'time' column")
@@ -229,7 +256,8 @@ def process_coordinates(motion: pd.DataFrame, *, cutoff: float | None = 6.0, ord
     cols = [c for c in motion.columns if c != "time"] if columns is None else list(columns)
     missing = [c for c in cols if c not in motion.columns]
     if missing:
-        raise InputError(f"{source}: columns {missing} are not in the motion")
+        others = [c for c in motion.columns if c != "time"]
+        raise InputError(f"{source}: columns {missing} are not in the motion{name_hint(str(missing[0]), others)}")
     if spline_degree not in (3, 5):
         raise InputError(f"spline_degree must be 3 or 5, got {spline_degree!r}")
     t = motion["time"].to_numpy(dtype=float)
@@ -244,8 +272,11 @@ def process_coordinates(motion: pd.DataFrame, *, cutoff: float | None = 6.0, ord
     fs = None
     pad = 0
     if cutoff is not None:
+        written = cutoff
+        cutoff = parse_quantity(cutoff, "Hz", where=f"{source}: cutoff")
         fs = _sample_rate(t, str(source))
         _check_filter(cutoff, fs, order, str(source))
+        check_cutoff(written, where=f"{source}: cutoff", accept=accept)
         pad = t.size // 2
         h = 1.0 / fs
         tp = np.concatenate([t[0] - h * np.arange(pad, 0, -1), t, t[-1] + h * np.arange(1, pad + 1)])

@@ -51,7 +51,9 @@ import pandas as pd
 
 from core.errors import InputError
 
-__all__ = ["muscle_inputs", "muscle_redundancy", "PELVIS_RESIDUALS"]
+from .checks import check_window, checked_options, name_hint
+
+__all__ = ["muscle_inputs", "muscle_redundancy", "reserve_optimal_forces", "PELVIS_RESIDUALS"]
 
 #: OpenSim's pelvis residual actuators and the coordinate each one is taken on (the force
 #: components on the pelvis translations, the torques on the pelvis rotation about the same axis:
@@ -60,11 +62,16 @@ PELVIS_RESIDUALS = {"FX": "pelvis_tx", "FY": "pelvis_ty", "FZ": "pelvis_tz",
                     "MX": "pelvis_list", "MY": "pelvis_rotation", "MZ": "pelvis_tilt"}
 
 
+@checked_options
 def muscle_inputs(trial, moments, window=None):
     """Per frame: moment arms, active and passive force per muscle, and τ.
 
+    ``window`` (start, end) [s] must lie inside the trial's time range (a window in per cent of
+    the gait cycle or in ms is refused as such, :class:`core.errors.DataRangeError`).
+
     Returns a dict with ``time`` (n,), ``R`` (n, n_coords, n_muscles), ``A``, ``P`` (n, n_muscles),
-    ``tau`` (n, n_coords), ``coordinates``, ``muscles``, ``muscle_set``, ``lengths`` (n, m),
+    ``tau`` (n, n_coords), ``coordinates``, ``coordinate_units`` (``"N m"`` for a rotational,
+    ``"N"`` for a translational coordinate), ``muscles``, ``muscle_set``, ``lengths`` (n, m),
     ``speeds`` (n, m) and the wall time of the geometry.
     """
     from .muscles import ThelenMuscleSet
@@ -73,6 +80,9 @@ def muscle_inputs(trial, moments, window=None):
     osim = trial.osim
     K = trial.kinematics
     t = K.q["time"].to_numpy(float)
+    if window is not None:
+        window = check_window(window, float(t[0]), float(t[-1]),
+                              where=f"muscle_inputs: trial {trial.settings.get('motion', '')}".rstrip())
     keep = np.ones(len(t), bool) if window is None else (t >= window[0] - 1e-9) & (t <= window[1] + 1e-9)
     if not keep.any():
         raise InputError(f"window {window} holds no frame of the trial ({t[0]:g}-{t[-1]:g} s)")
@@ -89,6 +99,11 @@ def muscle_inputs(trial, moments, window=None):
     rt = mus.rigid_tendon_forces(L, Ld)
     t1 = time.perf_counter()
     ctype = {c.name: c.motion_type for c in osim.coordinates}
+    missing = [c for c in names if (f"{c}_moment [N m]" if ctype[c] == "rotational" else f"{c}_force [N]")
+               not in moments.columns]
+    if "time [s]" not in moments.columns or missing:
+        raise InputError(f"muscle_inputs: moments lack {'time [s]' if 'time [s]' not in moments.columns else missing}: "
+                         f"pass the table of biomech.inverse_dynamics.inverse_dynamics(trial)")
     mt = moments["time [s]"].to_numpy(float)
     tau = []
     for c in names:
@@ -99,18 +114,33 @@ def muscle_inputs(trial, moments, window=None):
         tau.append(y[keep])
     return dict(time=t[keep], R=np.transpose(r, (0, 2, 1)), A=np.asarray(rt.active_force_per_activation), P=np.asarray(rt.passive_force),
                 tau=np.column_stack(tau), coordinates=names, muscles=list(sk.muscle_names), muscle_set=mus,
+                coordinate_units=["N m" if ctype[c] == "rotational" else "N" for c in names],
                 lengths=L, speeds=Ld, wall_time_geometry=t1 - t0, clamped=np.asarray(rt.kinematics.clamped))
 
 
 def reserve_optimal_forces(force_set, coordinates):
-    """Optimal force of the reserve on each coordinate (0: none), from an OpenSim force set."""
+    """Optimal force of the reserve on each coordinate (0: none), from an OpenSim force set.
+
+    Parameters
+    ----------
+    force_set : biomech.osim.ForceSet
+        From :func:`biomech.osim.read_force_set` (reserve and pelvis residual actuators).
+    coordinates : sequence of str
+        The coordinates in the order of the optimisation (``muscle_inputs(...)["coordinates"]``).
+
+    Returns
+    -------
+    ndarray, shape (n_coordinates,)
+        [N m] on a rotational, [N] on a translational coordinate.
+    """
     out = np.zeros(len(coordinates))
     for act in force_set.actuators:
         c = getattr(act, "coordinate", None) or PELVIS_RESIDUALS.get(act.name)
         if c is None:
             continue
         if c not in coordinates:
-            raise InputError(f"{force_set.path}: actuator {act.name!r} acts on {c!r}, which the model lacks")
+            raise InputError(f"{force_set.path}: actuator {act.name!r} acts on {c!r}, which the model lacks"
+                             f"{name_hint(c, coordinates)}")
         out[coordinates.index(c)] = float(act.optimal_force)
     return out
 
@@ -121,12 +151,24 @@ def muscle_redundancy(inputs, reserves, criterion="stress", exponent=None, passi
     ``criterion``: ``"stress"`` (Σ (F/PCSA)^p, p = 3 by default: the paper's) or
     ``"activation"`` (Σ a^p, p = 2: OpenSim's).  ``reserves``: optimal force per coordinate.
     ``passive=False`` leaves the passive fibre force out of the equations, as OpenSim's static
-    optimization does.
+    optimization does.  Other ``options`` are keyword arguments of :class:`StaticOptimization`
+    (a misspelt one is refused naming the closest); the reserve columns carry the unit of their
+    coordinate (``reserve_pelvis_tx [N]``, ``reserve_hip_flexion_r [N m]``).
     Returns the per-frame table of :meth:`StaticOptimization.solve_trial` with the wall times in
     ``attrs``.
     """
+    import inspect
+
+    from core.inputs import check_keywords
+
     from .static_optimization import StaticOptimization
 
+    accepted = [n for n in inspect.signature(StaticOptimization.__init__).parameters
+                if n not in ("self", "muscle_names", "coordinate_names", "max_isometric_force", "criterion",
+                             "exponent", "reserve_optimal_force")]
+    check_keywords(options, ["criterion", "exponent", "passive"] + accepted, where="muscle_redundancy()")
+    if "coordinate_units" not in options and "coordinate_units" in inputs:
+        options["coordinate_units"] = inputs["coordinate_units"]
     mus = inputs["muscle_set"]
     t0 = time.perf_counter()
     so = StaticOptimization(inputs["muscles"], inputs["coordinates"], mus.max_isometric_force, criterion=criterion,

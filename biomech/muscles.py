@@ -464,6 +464,10 @@ class ThelenMuscleSet:
         -------
         ThelenMuscleSet
         """
+        from core.inputs import check_keywords
+
+        check_keywords(overrides, [f.name for f in fields(cls) if f.name != "names"],
+                       where="ThelenMuscleSet.from_muscles()")
         items = list(muscles)
         kwargs: dict[str, object] = {"names": [str(m.name) for m in items]}
         for f in fields(cls):

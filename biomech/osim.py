@@ -91,7 +91,7 @@ from __future__ import annotations
 
 import warnings
 import xml.etree.ElementTree as ET
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
@@ -683,7 +683,8 @@ class OsimModel:
         try:
             return self._index[kind][name]
         except KeyError:
-            raise ModelError(f"model {self.name!r} ({self.path}) has no {label} {name!r}") from None
+            raise ModelError(f"model {self.name!r} ({self.path}) has no {label} {name!r}"
+                             f"{_hint(name, self._index[kind])}") from None
 
     def body(self, name: str) -> Body:
         """The body called ``name`` (ModelError if there is none)."""
@@ -808,6 +809,23 @@ class _Reader:
         self.doc = doc
         self.ignored: list[IgnoredItem] = []
         self.what = what
+        self.accept: frozenset[str] = frozenset()
+
+    def plausible(self, el, quantity: str, value: float, owner: str, tag: str) -> None:
+        """Check a value read from the file against its plausible range (file, line, element, tag named)."""
+        from core.inputs import ImplausibleValueError
+
+        from .checks import ImplausibleDataError, check_value
+
+        if quantity in self.accept:
+            return
+        child = el.find(tag)
+        line = self.doc.line(child if child is not None else el)
+        where = f"{self.doc.path}" + (f", line {line}" if line else "") + f": {owner} <{tag}>"
+        try:
+            check_value(quantity, value, where=where, accept=self.accept)
+        except ImplausibleValueError as exc:
+            raise ImplausibleDataError(str(exc), exc.quantity, exc.value, exc.suggestion) from None
 
     # ---- messages ---------------------------------------------------------------------------
     def where(self, el, context: str = "") -> str:
@@ -973,6 +991,7 @@ class _ModelReader(_Reader):
             inertia = np.array([[six[0], six[3], six[4]], [six[3], six[1], six[5]], [six[4], six[5], six[2]]])
             if not (np.isfinite(mass) and mass >= 0):
                 raise self.model_error(el, f"body {name!r}: mass must be finite and >= 0, got {mass}")
+            self.plausible(el, "segment_mass", mass, f"body {name!r}", "mass")
             eig = np.linalg.eigvalsh(inertia)
             if not np.all(np.isfinite(eig)) or eig[0] < -1e-12 * max(1.0, abs(eig[-1])):
                 raise self.model_error(el, f"body {name!r}: inertia {six.tolist()} is not positive semi-definite "
@@ -993,7 +1012,8 @@ class _ModelReader(_Reader):
         last = _last_component(ref)
         if last == self.ground or last in self.body_names:
             return last
-        raise self.model_error(el, f"{what} {ref!r} is neither ground nor a body of the model")
+        raise self.model_error(el, f"{what} {ref!r} is neither ground nor a body of the model"
+                                   f"{_hint(last, sorted(self.body_names | {self.ground}))}")
 
     def resolve_frame(self, ref: str, frames: dict[str, ET.Element], el, depth: int = 0) -> OffsetFrame:
         ref = ref.strip()
@@ -1248,6 +1268,14 @@ class _ModelReader(_Reader):
                 raise self.data_error(el, f"{owner}: missing <{required}>")
             if not (np.isfinite(v) and v > 0):
                 raise self.model_error(el, f"{owner}: {required} must be > 0, got {v}")
+        for tag, quantity in (("max_isometric_force", "max_isometric_force"),
+                              ("optimal_fiber_length", "optimal_fiber_length"),
+                              ("tendon_slack_length", "tendon_slack_length"),
+                              ("pennation_angle_at_optimal", "pennation_angle"),
+                              ("max_contraction_velocity", "max_contraction_velocity")):
+            v = vals[_MUSCLE_FIELDS[tag]] if tag in _MUSCLE_FIELDS else None
+            if v is not None:
+                self.plausible(el, quantity, v, owner, tag)
         props: dict[str, str] = {}
         self.flatten(el, "", props, set(_MUSCLE_FIELDS) | {"GeometryPath", "appliesForce", "isDisabled"})
         path = self.read_path(gp, owner)
@@ -1313,7 +1341,8 @@ class _ModelReader(_Reader):
             raise self.data_error(el, f"{ctx}: no coordinate named")
         name = _last_component(ref)
         if name not in self.coords:
-            raise self.model_error(el, f"{ctx}: coordinate {ref!r} is not a coordinate of the model")
+            raise self.model_error(el, f"{ctx}: coordinate {ref!r} is not a coordinate of the model"
+                                       f"{_hint(name, self.coords)}")
         return name
 
     # ---- markers ----------------------------------------------------------------------------
@@ -1377,12 +1406,14 @@ _ACTUATOR_READERS = {
 def _check_actuator(r: _Reader, el, act, coordinates, bodies):
     if isinstance(act, CoordinateActuator):
         if coordinates is not None and act.coordinate not in coordinates:
-            raise r.model_error(el, f"CoordinateActuator {act.name!r}: coordinate {act.coordinate!r} is not in the model")
+            raise r.model_error(el, f"CoordinateActuator {act.name!r}: coordinate {act.coordinate!r} is not in the model"
+                                    f"{_hint(act.coordinate, coordinates)}")
     else:
         names = [act.body] if isinstance(act, PointActuator) else [act.body_a, act.body_b]
         for b in names:
             if bodies is not None and b not in bodies:
-                raise r.model_error(el, f"{type(act).__name__} {act.name!r}: body {b!r} is not in the model")
+                raise r.model_error(el, f"{type(act).__name__} {act.name!r}: body {b!r} is not in the model"
+                                        f"{_hint(b, bodies)}")
     if not act.min_control <= act.max_control:
         raise r.model_error(el, f"{act.name!r}: min_control {act.min_control} > max_control {act.max_control}")
 
@@ -1390,6 +1421,18 @@ def _check_actuator(r: _Reader, el, act, coordinates, bodies):
 # =============================================================================================
 # reporting
 # =============================================================================================
+
+
+def checked_options(func):
+    from .checks import checked_options as wrap
+
+    return wrap(func)
+
+
+def _hint(name: str, candidates) -> str:
+    from .checks import name_hint
+
+    return name_hint(name, candidates)
 
 
 def report(ignored: list[IgnoredItem], path: Path | str, strict: bool, stacklevel: int = 2) -> None:
@@ -1416,7 +1459,8 @@ def report(ignored: list[IgnoredItem], path: Path | str, strict: bool, stackleve
 # =============================================================================================
 
 
-def read_osim(path: str | Path, *, strict: bool = False) -> OsimModel:
+@checked_options
+def read_osim(path: str | Path, *, strict: bool = False, accept: Sequence[str] = ()) -> OsimModel:
     """Read an OpenSim 4.x model file.
 
     Parameters
@@ -1426,6 +1470,10 @@ def read_osim(path: str | Path, *, strict: bool = False) -> OsimModel:
     strict : bool
         If True, any element the reader would ignore (see the module docstring) raises
         :class:`core.errors.ModelError` instead of an :class:`OsimReaderWarning`.
+    accept : sequence of str
+        Plausible-range quantities not to enforce (``"segment_mass"``, ``"max_isometric_force"``,
+        ``"optimal_fiber_length"``, ``"tendon_slack_length"``, ``"pennation_angle"``,
+        ``"max_contraction_velocity"``; ``data/biomech/plausible_ranges.csv``).
 
     Returns
     -------
@@ -1436,6 +1484,9 @@ def read_osim(path: str | Path, *, strict: bool = False) -> OsimModel:
     core.errors.DataFileError
         Missing, unreadable, malformed or truncated file (file and line named); an OpenSim 3.x file;
         a missing or non-numeric property; an unsupported function.
+    biomech.checks.ImplausibleDataError
+        A segment mass or muscle parameter outside its plausible range (body or muscle, tag and
+        line named, with the likely slip: grams, mm, cm, degrees).
     core.errors.ModelError
         Unknown joint or path-point type, references to bodies, frames or coordinates the model
         lacks, a body not connected to ground, a closed loop of joints (element and line named).
@@ -1453,9 +1504,12 @@ def read_osim(path: str | Path, *, strict: bool = False) -> OsimModel:
     >>> len(m.muscles), round(m.total_mass, 1)
     (18, 72.6)
     """
-    return _ModelReader(parse_xml(path)).read(strict)
+    reader = _ModelReader(parse_xml(path))
+    reader.accept = frozenset([accept] if isinstance(accept, str) else accept)
+    return reader.read(strict)
 
 
+@checked_options
 def read_force_set(path: str | Path, model: OsimModel | None = None, *, strict: bool = False) -> ForceSet:
     """Read an OpenSim force-set file of actuators (reserve and residual actuators).
 

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from core.errors import InputError
 from core.paths import data_path
 
 __all__ = ["biomech_scenes", "GAIT10DOF"]
@@ -43,7 +44,8 @@ def right_gait_cycle(trial):
 
     hs, _ = gait_events(trial.loads, "calcn_r")
     if len(hs) < 2:
-        raise ValueError("the trial holds fewer than two right heel strikes")
+        raise InputError(f"{trial.settings.get('external_loads', 'the trial')}: fewer than two right heel strikes "
+                         f"(calcn_r's vertical ground reaction rises through 20 N only {len(hs)} times)")
     return float(hs[0]), float(hs[1])
 
 
@@ -240,7 +242,8 @@ def _run_muscle_forces(ctx):
     for crit, p, label in CRITERIA:
         d = sols[crit]
         for c in [c for c in d.columns if c.startswith("reserve_")]:
-            res_rows.append({"criterion": crit, "reserve": c, "max |.|": float(d[c].abs().max()),
+            res_rows.append({"criterion": crit, "reserve": c, "unit": c[c.index("[") + 1:-1],
+                             "max |.|": float(d[c].abs().max()),
                              "rms": float(np.sqrt(np.mean(d[c] ** 2)))})
     cmp_rows = []
     if peer is not None:
@@ -266,8 +269,9 @@ def _run_muscle_forces(ctx):
         f"OpenSim's subject01 walk: per frame, the joint moments of core's inverse dynamics (scene "
         f"gait-inverse-dynamics) shared by 18 Hill-type muscles (Thelen 2003 curves, rigid tendon, passive force "
         f"included; moment arms -dL/dq of the paths with their via, conditional and moving points) and the reserve "
-        f"actuators of gait10dof_Reserve_Actuators.xml (optimal force 1 N m: expensive; the pelvis residuals FX, FY, MZ "
-        f"on the pelvis coordinates), activations in [0, 1]; one cvxpy problem with parameters per model, solved by "
+        f"actuators of gait10dof_Reserve_Actuators.xml (optimal force 1 N m on each joint: expensive; the pelvis "
+        f"residuals FX, FY (1 N, 2 N) and MZ (1 N m) on the pelvis coordinates tx, ty, tilt, so their columns are "
+        f"in N, N and N m), activations in [0, 1]; one cvxpy problem with parameters per model, solved by "
         f"Clarabel (the cubic criterion's powers as exact second-order cones through cvxpy's power atom, the default; Clarabel's native power cones with epigraph='power_cone'). Frames not 'optimal': "
         f"{', '.join(f'{k}: {v}' for k, v in n_bad.items())} (per-frame status table). The lumbar extension moment "
         f"and the pelvis residuals are carried by reserves alone (no muscle spans them in this model). "
@@ -356,7 +360,7 @@ def _gait2392_static_optimization(ctx, with_peer):
         res_col = [c for c in d.columns if c.startswith("max |R F")][0]
         status.append({"criterion": crit, "passive force": "included" if passive else "left out (as OpenSim)",
                        "frames": len(d), **{f"frames {k}": v for k, v in counts.items()},
-                       "largest residual [N m]": float(d[res_col].max()),
+                       f"largest residual {res_col[res_col.index('['):]}": float(d[res_col].max()),
                        "per frame [ms]": 1e3 * d.attrs["wall_time_solve"] / len(d)})
     infeasible = runs[("activation", True)]
     bad = infeasible["status"] != "optimal"

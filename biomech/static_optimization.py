@@ -120,6 +120,8 @@ import pandas as pd
 
 from core.errors import InputError, ModelError, UnknownOptionError
 
+from .checks import checked_options, name_hint
+
 __all__ = [
     "SPECIFIC_TENSION",
     "DEFAULT_RETRY_OPTIONS",
@@ -391,6 +393,7 @@ class StaticOptimization:
     ('optimal', True)
     """
 
+    @checked_options
     def __init__(self, muscle_names: Sequence[str], coordinate_names: Sequence[str], max_isometric_force, *,
                  criterion: str = "activation", exponent: float | None = None, pcsa=None,
                  specific_tension: float = SPECIFIC_TENSION, reserve_optimal_force=None, reserve_bounds=None,
@@ -420,7 +423,8 @@ class StaticOptimization:
         self.max_isometric_force = f0
 
         if criterion not in CRITERIA:
-            raise UnknownOptionError(f"criterion {criterion!r} is not one of {sorted(CRITERIA)}")
+            raise UnknownOptionError(f"criterion {criterion!r} is not one of {sorted(CRITERIA)}"
+                                     f"{name_hint(str(criterion), sorted(CRITERIA))}")
         self.criterion = criterion
         p = CRITERIA[criterion] if exponent is None else float(exponent)
         if not (math.isfinite(p) and p >= 1.0):
@@ -490,7 +494,8 @@ class StaticOptimization:
         self.coordinate_units = tuple(units)
 
         if epigraph not in ("power_cone", "soc"):
-            raise UnknownOptionError(f"epigraph {epigraph!r} is not one of ['power_cone', 'soc']")
+            raise UnknownOptionError(f"epigraph {epigraph!r} is not one of ['power_cone', 'soc']"
+                                     f"{name_hint(str(epigraph), ['power_cone', 'soc'])}")
         self.epigraph = epigraph
         self.solver_options = dict(solver_options or {})
         self.retry_options = tuple(dict(r) for r in retry_options)

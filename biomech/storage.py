@@ -30,13 +30,26 @@ string, ``""`` where unknown).
 Checks, each an error naming the file (and line or column): a missing ``endheader`` or label
 line, a missing ``time`` column, a row with the wrong number of values or a value that is not a
 number (line and column named), fewer or more rows than ``nRows`` says (a truncated file), a label
-count different from ``nColumns``, times that do not strictly increase (line named).  An
-implausible ``inDegrees`` flag: with ``inDegrees=no`` (or no flag) an angle column that reaches
-beyond 2π rad or spans more than 2π rad in magnitude is degrees written as radians (the known
-pitfall of RRA output, which makes static optimisation fail with NaN fibre lengths) -- raised as
-:class:`core.errors.DataFileError` naming the file, the flag and the column (``check_degrees="warn"``
-warns instead, ``"off"`` skips the check).  A motion whose values are degrees below 2π in magnitude
-cannot be told from radians; the check cannot catch it.
+count different from ``nColumns``, times that do not strictly increase (line named), a gap of
+missing (NaN) values (column and time range named; ``allow_nan=True`` reads it).  An implausible
+``inDegrees`` flag, in both directions (:func:`biomech.checks.angle_unit_slip`):
+
+* with ``inDegrees=no`` (or no flag) an angle column that reaches beyond 2π rad or spans more than
+  2π rad is degrees written as radians (the known pitfall of RRA output, which makes static
+  optimisation fail with NaN fibre lengths);
+* with ``inDegrees=yes``, every angle column within ±π while the largest span is at least 0.8
+  (46° of motion if radians, under 1° if degrees) is radians written under a degrees flag (a
+  walking knee spans 60-75°).
+
+Either is raised as :class:`core.errors.DataFileError` naming the file, the flag and the column
+(``check_degrees="warn"`` warns instead, ``"off"`` skips the check).  A motion whose values are
+degrees below 2π in magnitude, or radians of a motion spanning less than 0.8 rad, cannot be told
+apart; the check does not guess there.  Translation coordinates (``*_tx``, ``*_ty``, ``*_tz``, or the
+model's translational coordinates) are checked against their plausible ranges
+(``data/biomech/plausible_ranges.csv``: pelvis_ty -0.5 ... 2.5 m, others ±100 m); values in mm or
+cm are named as such (:class:`biomech.checks.ImplausibleDataError`; ``accept=[...]`` lets them
+through).  :func:`read_external_loads` checks the centre of pressure (±10 m), the free torque
+(±500 N m) and the largest force (50 N ... 20 kN: ground reactions in body weights or N/kg are named).
 
 External loads
 --------------
@@ -65,7 +78,6 @@ natural spline).
 
 from __future__ import annotations
 
-import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -77,6 +89,7 @@ from scipy.interpolate import CubicSpline
 
 from core.errors import DataFileError, DataRangeError, InputError
 
+from .checks import angle_unit_slip, check_column_magnitude, checked_options, nan_gaps, name_hint
 from .osim import OsimModel, parse_xml
 
 __all__ = [
@@ -93,7 +106,6 @@ __all__ = [
 ]
 
 _TRANSLATION_SUFFIXES = ("_tx", "_ty", "_tz")
-_TWO_PI = 2.0 * math.pi
 
 
 class StorageWarning(UserWarning):
@@ -206,8 +218,10 @@ def _angle_columns(data_cols: list[str], model: OsimModel | None, angle_columns,
     return [c for c in data_cols if not c.endswith(_TRANSLATION_SUFFIXES)]
 
 
+@checked_options
 def read_storage(path: str | Path, model: OsimModel | None = None, *, convert_angles: bool = True,
-                 angle_columns: Sequence[str] | None = None, check_degrees: str = "raise") -> pd.DataFrame:
+                 angle_columns: Sequence[str] | None = None, check_degrees: str = "raise",
+                 allow_nan: bool = False, accept: Sequence[str] = ()) -> pd.DataFrame:
     """Read an OpenSim ``.sto`` / ``.mot`` file into a DataFrame in SI units.
 
     Parameters
@@ -220,7 +234,15 @@ def read_storage(path: str | Path, model: OsimModel | None = None, *, convert_an
     angle_columns : sequence of str, optional
         Columns that are angles, overriding the model and the naming rule.
     check_degrees : {"raise", "warn", "off"}
-        What to do about an implausible ``inDegrees=no`` (see the module docstring).
+        What to do about an implausible ``inDegrees`` flag, in either direction: degrees under
+        ``inDegrees=no`` or radians under ``inDegrees=yes`` (see the module docstring and
+        :func:`biomech.checks.angle_unit_slip` for the heuristic and its thresholds).
+    allow_nan : bool
+        If False (default) a missing (NaN) value in a data column is refused, naming the column and
+        the gap's time range; True reads it as NaN.
+    accept : sequence of str
+        Plausible-range quantities not to enforce (``"pelvis_height"``, ``"translation_coordinate"``;
+        ``data/biomech/plausible_ranges.csv``).
 
     Returns
     -------
@@ -233,10 +255,15 @@ def read_storage(path: str | Path, model: OsimModel | None = None, *, convert_an
     core.errors.DataFileError
         Missing file, no ``endheader``, no time column, wrong value counts, non-numeric values,
         fewer or more rows than ``nRows``, label count not ``nColumns``, non-increasing times,
-        implausible ``inDegrees=no`` (with ``check_degrees="raise"``).
+        implausible ``inDegrees`` flag (with ``check_degrees="raise"``), NaN gaps (unless
+        ``allow_nan``).
+    biomech.checks.ImplausibleDataError
+        A translation coordinate (``*_tx``, ``*_ty``, ``*_tz``, or the model's translational
+        coordinates) beyond its plausible range, e.g. in mm ("the values look like mm").
     """
     if check_degrees not in ("raise", "warn", "off"):
-        raise InputError(f"check_degrees must be 'raise', 'warn' or 'off', got {check_degrees!r}")
+        raise InputError(f"check_degrees must be 'raise', 'warn' or 'off', got {check_degrees!r}"
+                         f"{name_hint(str(check_degrees), ['raise', 'warn', 'off'])}")
     p = Path(path)
     lines = _read_text(p).splitlines()
     end, header, name = _parse_header(lines, p)
@@ -277,33 +304,29 @@ def read_storage(path: str | Path, model: OsimModel | None = None, *, convert_an
     dt = np.diff(t)
     if np.any(dt <= 0):
         bad = int(np.flatnonzero(dt <= 0)[0]) + 1
-        raise DataFileError(f"{p}, line {line_numbers[bad]}: time {t[bad]!r} does not increase (previous row "
-                            f"{t[bad - 1]!r})")
+        raise DataFileError(f"{p}, line {line_numbers[bad]}: time {float(t[bad])!r} does not increase (previous row "
+                            f"{float(t[bad - 1])!r})")
     data_cols = [s for i, s in enumerate(labels) if i != ti]
     df = pd.DataFrame(values[:, [i for i in range(len(labels)) if i != ti]], columns=data_cols)
     df.insert(0, "time", t)
 
+    if not allow_nan:
+        gap = nan_gaps(t, df[data_cols].to_numpy(float), data_cols)
+        if gap:
+            raise DataFileError(f"{p}: {gap}: fill the gap (e.g. interpolate it) or cut the trial before it "
+                                f"(allow_nan=True reads it as NaN)")
     in_degrees = _in_degrees(header, p)
     angles = _angle_columns(data_cols, model, angle_columns, convert_angles, p)
+    if angles and check_degrees != "off":
+        slip = angle_unit_slip({c: df[c].to_numpy() for c in angles}, in_degrees)
+        if slip:
+            really = "radians" if not in_degrees else "degrees"
+            msg = f"{p}: {slip} (or pass check_degrees='warn' / 'off' if they really are {really})"
+            if check_degrees == "raise":
+                raise DataFileError(msg)
+            warnings.warn(msg, StorageWarning, stacklevel=2)
     if angles and in_degrees:
         df[angles] = np.deg2rad(df[angles].to_numpy())
-    elif angles and check_degrees != "off":
-        flag = "inDegrees=no" if in_degrees is False else "no inDegrees flag (taken as no)"
-        for col in angles:
-            v = df[col].to_numpy()
-            finite = v[np.isfinite(v)]
-            if finite.size == 0:
-                continue
-            reach = float(np.max(np.abs(finite)))
-            span = float(np.ptp(finite))
-            if reach > _TWO_PI or span > _TWO_PI:
-                msg = (f"{p}: the header has {flag}, but angle column {col!r} reaches {reach:.4g} and spans "
-                       f"{span:.4g} 'rad' (more than 2π): the values look like degrees; correct the header to "
-                       f"inDegrees=yes (or pass check_degrees='warn' / 'off' if they really are radians)")
-                if check_degrees == "raise":
-                    raise DataFileError(msg)
-                warnings.warn(msg, StorageWarning, stacklevel=2)
-                break
     if model is not None and in_degrees and convert_angles and angle_columns is None:
         coupled = [c.name for c in model.coordinates if c.motion_type == "coupled" and c.name in data_cols]
         if coupled:
@@ -321,11 +344,17 @@ def read_storage(path: str | Path, model: OsimModel | None = None, *, convert_an
             units[col] = "m"
         else:
             units[col] = ""
+    for col in data_cols:
+        if units[col] == "m" and col not in angles:
+            quantity = "pelvis_height" if col == "pelvis_ty" else "translation_coordinate"
+            check_column_magnitude(quantity, df[col].to_numpy(), where=str(p), column=col, accept=accept,
+                                   typical=(0.5, 1.5) if quantity == "pelvis_height" else None)
     df.attrs.update(source=str(p), name=name, header=dict(header), in_degrees=in_degrees,
                     angle_columns=list(angles), units=units)
     return df
 
 
+@checked_options
 def check_motion_against_model(motion: pd.DataFrame, model: OsimModel, *, source: str | None = None) -> tuple[str, ...]:
     """Check that every data column of a motion is a coordinate of ``model``.
 
@@ -353,9 +382,12 @@ def check_motion_against_model(motion: pd.DataFrame, model: OsimModel, *, source
     cols = [c for c in motion.columns if c != "time"]
     unknown = [c for c in cols if c not in names]
     if unknown:
+        hints = {c: name_hint(c, model.coordinate_names)[len("; did you mean "):-1] for c in unknown
+                 if name_hint(c, model.coordinate_names)}
+        more = "".join(f"; {k!r}: did you mean {v}?" for k, v in hints.items())
         raise DataFileError(f"{src}: column{'s' if len(unknown) > 1 else ''} {unknown} {'are' if len(unknown) > 1 else 'is'} "
                             f"not {'coordinates' if len(unknown) > 1 else 'a coordinate'} of model {model.name!r} "
-                            f"({model.path}); its coordinates are {list(model.coordinate_names)}")
+                            f"({model.path}); its coordinates are {list(model.coordinate_names)}{more}")
     return tuple(c for c in model.coordinate_names if c not in cols)
 
 
@@ -547,7 +579,9 @@ def _three_columns(df: pd.DataFrame, identifier: str, what: str, spec: ExternalF
     return cols
 
 
-def read_external_loads(path: str | Path, datafile: str | Path | None = None) -> ExternalLoads:
+@checked_options
+def read_external_loads(path: str | Path, datafile: str | Path | None = None, *,
+                        accept: Sequence[str] = ()) -> ExternalLoads:
     """Read an external-loads XML file and its force-plate data.
 
     Parameters
@@ -556,6 +590,9 @@ def read_external_loads(path: str | Path, datafile: str | Path | None = None) ->
         The ``ExternalLoads`` XML file.
     datafile : str or Path, optional
         The data file, overriding the XML's ``<datafile>``.
+    accept : sequence of str
+        Plausible-range quantities not to enforce (``"ground_reaction_force"``,
+        ``"centre_of_pressure"``, ``"free_torque"``; ``data/biomech/plausible_ranges.csv``).
 
     Returns
     -------
@@ -567,6 +604,9 @@ def read_external_loads(path: str | Path, datafile: str | Path | None = None) ->
     core.errors.DataFileError
         Problems of either file (see :func:`read_external_loads_xml`, :func:`read_storage`); an
         identifier that does not match exactly three columns (file, force and identifier named).
+    biomech.checks.ImplausibleDataError
+        Forces whose largest magnitude is below 50 N (body weights or N/kg rather than N), a centre
+        of pressure beyond 10 m (mm), a free torque beyond 500 N m (N mm).
     """
     spec = read_external_loads_xml(path)
     data_path = Path(datafile) if datafile is not None else spec.datafile
@@ -590,11 +630,46 @@ def read_external_loads(path: str | Path, datafile: str | Path | None = None) ->
             arrays[key] = a
         forces.append(ExternalForceData(f, t, arrays["force"], arrays["point"], arrays["torque"],
                                         {"force": fc, "point": pc, "torque": tc}))
+    for f in forces:
+        for key, quantity, slips in (("point", "centre_of_pressure", ("mm", "cm")),
+                                     ("torque", "free_torque", ("N*mm",))):
+            a = getattr(f, key)
+            if a is not None:
+                k = int(np.argmax(np.max(np.abs(a), axis=0)))
+                check_column_magnitude(quantity, a[:, k], where=src, column=f.columns[key][k], accept=accept,
+                                       slips=slips)
+    _check_force_magnitude(forces, src, accept)
     t = t.copy()
     t.flags.writeable = False
     return ExternalLoads(spec, src, t, tuple(forces))
 
 
+def _check_force_magnitude(forces, src: str, accept) -> None:
+    """Refuse force data whose largest magnitude is below a plausible ground reaction (N)."""
+    from .checks import ImplausibleDataError, ranges
+
+    if "ground_reaction_force" in set(accept) or not forces:
+        return
+    peaks = [(float(np.max(np.linalg.norm(f.force, axis=1))), f) for f in forces if f.spec.applies_force]
+    if not peaks:
+        return
+    peak, f = max(peaks, key=lambda x: x[0])
+    r = ranges()["ground_reaction_force"]
+    if peak == 0 or r.contains(peak):
+        return
+    cols = f.columns["force"]
+    if peak < r.low:
+        slip = (f"the values look like body weights (or N/kg, or kN); ground reactions must be in N "
+                f"(multiply body weights by m·g)")
+    else:
+        slip = f"the values look like mN or another unit; ground reactions must be in N"
+    raise ImplausibleDataError(f"{src}: the largest ground reaction force ({cols[0]}..{cols[-1][-1]}) is "
+                               f"{peak:.4g} N, outside the plausible range {r.describe()}: {slip} "
+                               f"(to use it deliberately, accept='ground_reaction_force')",
+                               "ground_reaction_force", peak, slip)
+
+
+@checked_options
 def resample_external_loads(loads: ExternalLoads, times, *, method: str = "spline") -> ExternalLoads:
     """Interpolate external loads onto other times (e.g. the kinematics' samples).
 
@@ -619,7 +694,7 @@ def resample_external_loads(loads: ExternalLoads, times, *, method: str = "splin
         the requested range are named.
     """
     if method not in ("spline", "linear"):
-        raise InputError(f"method must be 'spline' or 'linear', got {method!r}")
+        raise InputError(f"method must be 'spline' or 'linear', got {method!r}{name_hint(str(method), ['spline', 'linear'])}")
     tq = np.asarray(times, dtype=float)
     if tq.ndim != 1 or tq.size == 0 or not np.all(np.isfinite(tq)):
         raise InputError(f"times must be a non-empty 1-D array of finite values, got shape {tq.shape}")

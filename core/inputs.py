@@ -191,7 +191,7 @@ def parse_quantity(value, unit: str, *, where: str = "value"):
 # ---------------------------------------------------------------------------------------------
 #: units a slip is usually made in, by SI unit of the quantity (the likely-slip suggestions)
 _SLIP_UNITS: dict[str, tuple[str, ...]] = {
-    "kg": ("t", "g"),
+    "kg": ("t", "g", "lb"),
     "m": ("mm", "cm", "km"),
     "m/s": ("km/h", "mm/s"),
     "m/s^2": ("mm/s^2",),

@@ -39,7 +39,6 @@ Orthop. Relat. Res. 467:1074-1082 (muscle architecture); de Leva P. (1996) J. Bi
 from __future__ import annotations
 
 import functools
-import inspect
 import math
 import warnings
 from collections.abc import Iterable, Sequence
@@ -47,7 +46,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 
 from core.errors import DataFileError, DataRangeError, InputError
-from core.inputs import ImplausibleValueError, RangeTable, check_keywords, closest
+from core.inputs import ImplausibleValueError, RangeTable, checked_options, closest
 
 __all__ = [
     "RANGES",
@@ -301,31 +300,6 @@ def name_hint(name: str, candidates: Iterable[str]) -> str:
     if str(name).lower() in low:
         return f"; did you mean {low[str(name).lower()]!r}?"
     return closest(name, cands)
-
-
-# ---------------------------------------------------------------------------------------------
-# keyword arguments
-# ---------------------------------------------------------------------------------------------
-def checked_options(func):
-    """Refuse unknown keyword arguments of ``func`` with :class:`core.errors.UnknownOptionError`
-    naming the closest accepted one (instead of Python's bare ``TypeError``)."""
-    sig = inspect.signature(func)
-    params = sig.parameters
-    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
-        return func
-    names = [n for n, p in params.items() if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD,
-                                                          inspect.Parameter.KEYWORD_ONLY) and n != "self"]
-    qual = func.__qualname__.replace(".__init__", "")
-
-    @functools.wraps(func)
-    def wrapper(*args, **kwargs):
-        if kwargs:
-            unknown = [k for k in kwargs if k not in params]
-            if unknown:
-                check_keywords(unknown, names, where=f"{qual}()")
-        return func(*args, **kwargs)
-
-    return wrapper
 
 
 def warn_sampling(message: str) -> None:

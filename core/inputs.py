@@ -60,6 +60,7 @@ __all__ = [
     "closest",
     "check_choice",
     "check_keywords",
+    "checked_options",
     "unit_registry",
 ]
 
@@ -415,6 +416,31 @@ def check_keywords(given: Iterable[str], accepted: Iterable[str], *, where: str)
         if k not in accepted:
             raise UnknownOptionError(f"{where}: unknown option {k!r}{closest(k, accepted)} "
                                      f"(accepted: {', '.join(accepted)})")
+
+
+def checked_options(func):
+    """Decorator: refuse unknown keyword arguments of ``func`` with :class:`UnknownOptionError`
+    naming the closest accepted one (instead of Python's bare ``TypeError``).  A function that
+    takes ``**kwargs`` is returned unchanged."""
+    import inspect
+
+    sig = inspect.signature(func)
+    params = sig.parameters
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()):
+        return func
+    names = [n for n, p in params.items() if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD,
+                                                          inspect.Parameter.KEYWORD_ONLY) and n != "self"]
+    qual = func.__qualname__.replace(".__init__", "")
+
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        if kwargs:
+            unknown = [k for k in kwargs if k not in params]
+            if unknown:
+                check_keywords(unknown, names, where=f"{qual}()")
+        return func(*args, **kwargs)
+
+    return wrapper
 
 
 def _fields_at(schema, loc) -> list[str]:

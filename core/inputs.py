@@ -112,6 +112,9 @@ def _convert_one(value, unit: str, where: str) -> float:
         v = float(value)
     elif isinstance(value, str):
         text = value.strip()
+        if "," in text:  # pint would read "1,435 m" as 1435 m
+            raise UnitError(f"{where}: {value!r} has a comma; write a decimal point (1.435 m) and no "
+                            f"thousands separator")
         try:
             v = float(text)  # a bare number written as a string: in the declared unit
         except ValueError:
@@ -190,6 +193,11 @@ def parse_quantity(value, unit: str, *, where: str = "value"):
 # ---------------------------------------------------------------------------------------------
 # plausible ranges
 # ---------------------------------------------------------------------------------------------
+#: in a range that contains zero, a slip is named only if the corrected value is at least this
+#: fraction of the range's largest bound: every tiny value lies in such a range, and a 0.3 m
+#: cant against a 0.2 m limit is no 0.3 mm cant
+SLIP_MIN_FRACTION = 0.02
+
 #: units a slip is usually made in, by SI unit of the quantity (the likely-slip suggestions)
 _SLIP_UNITS: dict[str, tuple[str, ...]] = {
     "kg": ("t", "g", "lb"),
@@ -239,12 +247,16 @@ class PlausibleRange:
         if not _is_number(written) or written == 0:
             return ""
         read_in = read_in or self.unit
+
         ureg = unit_registry()
         for u in (self.unit,) + _SLIP_UNITS.get(self.unit, ()):
             if u == read_in:
                 continue
             factor = float(ureg.Quantity(1.0, u).to(self.unit).magnitude)
-            if self.contains(written * factor):
+            guess = written * factor
+            if self.low <= 0 <= self.high and abs(guess) < SLIP_MIN_FRACTION * max(abs(self.low), abs(self.high)):
+                continue
+            if self.contains(guess):
                 return f"did you mean {_fmt(written)} {_pretty(u)}?"
         return ""
 
@@ -253,12 +265,21 @@ def _pretty(unit: str) -> str:
     return unit.replace("*", " ").replace("^2", "²").replace("percent", "%")
 
 
+#: units printed with an SI prefix when their value is large (1.2 MN/m rather than 1.2e+06 N/m)
+_PREFIXED = ("N", "N/m", "N*s/m", "N*m/rad", "N*m", "Pa")
+
+
 def _with_unit(v: float, unit: str) -> str:
-    """A bound written in a unit an engineer reads easily (1 t rather than 1000 kg)."""
+    """A value written in a unit an engineer reads easily (1 t rather than 1000 kg, 1.2 MN/m
+    rather than 1.2e+06 N/m)."""
     if unit == "kg" and abs(v) >= 1000:
         return f"{_fmt(v / 1000)} t"
     if unit == "1":
         return _fmt(v)
+    if unit in _PREFIXED:
+        for prefix, f in (("G", 1e9), ("M", 1e6), ("k", 1e3)):
+            if abs(v) >= f:
+                return f"{_fmt(v / f)} {prefix}{_pretty(unit)}"
     return f"{_fmt(v)} {_pretty(unit)}"
 
 
@@ -296,6 +317,8 @@ class RangeTable:
                 raise DataFileError(f"range table {path}, data row {i}: {_short(exc)}") from None
             if not lo <= hi:
                 raise DataFileError(f"range table {path}: {row['quantity']} has low > high")
+            if any(r.quantity == out[-1].quantity for r in out[:-1]):
+                raise DataFileError(f"range table {path}: quantity {out[-1].quantity!r} appears twice")
         return cls(out, source=str(path))
 
     def __getitem__(self, quantity: str) -> PlausibleRange:
@@ -345,7 +368,8 @@ class RangeTable:
             slip = r.likely_slip(float(w), unit) if _is_number(w) else ""
             pos = f"[{i}] " if vals.size > 1 or np.ndim(v) > 0 else ""
             lead = f"{where}: " if where else ""
-            msg = (f"{lead}{r.label} {pos}{_with_unit(float(x), r.unit)} is outside the plausible range "
+            shown = _with_unit(float(x), r.unit) if r.unit in ("kg", "1") else f"{_fmt(x)} {_pretty(r.unit)}"
+            msg = (f"{lead}{r.label} {pos}{shown} is outside the plausible range "
                    f"{r.describe()}")
             msg += f": {slip}" if slip else f" ({r.rationale})" if r.rationale else ""
             msg += f" (to use it deliberately, accept={quantity!r})"

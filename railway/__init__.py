@@ -42,6 +42,7 @@ from .contact_search import ContactResult, ContactSearch, wheelset_pose
 from .forces import ContactForces
 from .profiles import RailProfile, WheelProfile, read_profile_file, s1002_exact, uic60_exact
 from .quasi_static import quasi_static_contact, quasi_static_summary
+from .ranges import IrregularityStepWarning, RailwayInputWarning, SuspensionGeometryWarning
 from .vehicle import Vehicle, VehicleDefinition, build_vehicle
 from .wheel_rail import WheelRailContact, contact_history
 from .surfaces import RailSurface, WheelSurface
@@ -62,10 +63,13 @@ __all__ = [
     "ContactSearch",
     "Curve",
     "Irregularities",
+    "IrregularityStepWarning",
     "RailMounting",
+    "RailwayInputWarning",
     "RailProfile",
     "RailSurface",
     "Straight",
+    "SuspensionGeometryWarning",
     "Track",
     "TrackFrame",
     "Transition",

@@ -81,8 +81,10 @@ from core.errors import InputError
 
 from .creep import CreepForces, CreepModel, KalkerLinear, Polach2000, get_creep_model, kalker_coefficients
 
-__all__ = ["ContactForces", "FORCE_KEYS", "lankarani_nikravesh_force", "wheel_rail_curvatures"]
+__all__ = ["ContactForces", "FORCE_KEYS", "REDUCTIONS", "lankarani_nikravesh_force", "wheel_rail_curvatures"]
 
+#: terms of the contact forces that :class:`ContactForces` can switch off (its "Reduced models")
+REDUCTIONS = ("spin_creepage", "roll_rate_creepage", "contact_angle", "gravitational_stiffness")
 #: keys of the dictionary returned by :meth:`ContactForces.__call__`, arrays (n_wheels, 2)
 FORCE_KEYS = ("N", "Fx", "Fy", "Mz", "xi", "eta", "phi", "a", "b", "delta_dot")
 _RHO_MAX = 1e3
@@ -478,6 +480,30 @@ class ContactForces:
         Constructor parameters of the creep law given by name or class (e.g. Polach 2005's
         ``k_A, k_S, A, B, speed``).  Note that Polach 2005 evaluates its slip velocity with its
         own ``speed`` parameter, not with the rolling speed of the wheelsets.
+    spin_creepage, roll_rate_creepage, contact_angle, gravitational_stiffness : bool
+        Terms of the contact forces, all on by default (the full model); switching one off gives
+        the reduced models below, for like-for-like comparisons with the linear wheelset models
+        (:class:`railway.hunting.LinearWheelset`).  Any of them off runs on the numpy reference
+        path.
+
+    Notes
+    -----
+    Reduced models (each switch removes one mechanism the classical two-degree-of-freedom
+    wheelset neglects; Wickens 2003, ch. 2):
+
+    * ``spin_creepage=False``: the spin creepage φ passed to the creep law is zero, and the spin
+      moment M_z is dropped (Kalker's f23 and f33 terms, static and dynamic).
+    * ``roll_rate_creepage=False``: the creepages use the wheelset's angular velocity without its
+      component about the forward axis f, ω − (ω·f) f, so the roll rate does not move the contact
+      point (the term ρ h ẏ / V of the lateral creepage, :class:`railway.hunting.LinearWheelset`).
+    * ``contact_angle=False``: creepages and creep forces in the wheelset's own frame, t = f,
+      l = a (the axle), spin about u = f × a, instead of the contact plane (t, l, n) of the
+      module docstring; needs ``A_ws`` to be the unspun frame [f, a, u].
+    * ``gravitational_stiffness=False``: only the normal force's component along the track's up
+      axis b_T acts, N (n·b_T) b_T: its lateral and longitudinal components (the gravitational
+      stiffness, and the path by which the wheels' load transfer couples roll and lateral
+      motion) are dropped; the wheel loads, and so the Hertz ellipses, are those of the full
+      model.  Needs ``up_ws`` in :meth:`__call__`.
 
     Attributes
     ----------
@@ -487,6 +513,8 @@ class ContactForces:
         Its registry name.
     compiled : bool
         True when the numba kernel is used.
+    reduced : list of str
+        The terms of :data:`REDUCTIONS` switched off (empty for the full model).
 
     Raises
     ------
@@ -504,7 +532,8 @@ class ContactForces:
     """
 
     def __init__(self, E=2.1e11, nu=0.28, mu=0.3, creep_model="polach2000", restitution=0.9,
-                 approach_velocity_floor=0.1, compiled="auto", creep_params=None):
+                 approach_velocity_floor=0.1, compiled="auto", creep_params=None, spin_creepage=True,
+                 roll_rate_creepage=True, contact_angle=True, gravitational_stiffness=True):
         for name, val, ok in (("E", E, E > 0), ("nu", nu, 0.0 <= nu <= 0.5), ("mu", mu, mu > 0),
                               ("restitution", restitution, 0.0 <= restitution <= 1.0),
                               ("approach_velocity_floor", approach_velocity_floor,
@@ -520,7 +549,13 @@ class ContactForces:
         else:
             self.creep_law = get_creep_model(creep_model, **(creep_params or {}))
             self.creep_model = self.creep_law.name
-        code = _kernel_code(self.creep_law)
+        self.spin_creepage, self.roll_rate_creepage = bool(spin_creepage), bool(roll_rate_creepage)
+        self.contact_angle, self.gravitational_stiffness = bool(contact_angle), bool(gravitational_stiffness)
+        self.reduced = [k for k in REDUCTIONS if not getattr(self, k)]
+        code = None if self.reduced else _kernel_code(self.creep_law)
+        if compiled is True and self.reduced:
+            raise InputError(f"ContactForces: compiled=True, but the terms {self.reduced} are switched off, "
+                             "which only the numpy reference path does; use compiled='auto' or False")
         if compiled is True and code is None:
             raise InputError(f"ContactForces: compiled=True, but the numba kernel implements only the "
                              f"creep laws of railway.creep with join='scaled', not {self.creep_law!r}; "
@@ -554,7 +589,7 @@ class ContactForces:
         self._t0, self._dt = float(t[0]), float(t[1] - t[0])
         self._tab = np.ascontiguousarray(np.vstack([mH, mH * g, K, *C]))
 
-    def __call__(self, res, r_ws, A_ws, v_ws, omega_ws):
+    def __call__(self, res, r_ws, A_ws, v_ws, omega_ws, up_ws=None):
         """Forces on the wheels for the contacts ``res`` of wheelsets moving with (v_ws, omega_ws).
 
         Parameters
@@ -567,6 +602,8 @@ class ContactForces:
             Wheelset orientations (column 0: forward axis, giving the rolling direction).
         v_ws, omega_ws : (n_ws, 3) array_like
             Wheelset centre velocity (m/s) and angular velocity including the spin (rad/s), global.
+        up_ws : (n_ws, 3) array_like, optional
+            The track's up axis at every wheelset; needed only with ``gravitational_stiffness=False``.
 
         Returns
         -------
@@ -596,7 +633,10 @@ class ContactForces:
         fwd = np.ascontiguousarray(A_ws[:, :, 0])
         if self._kernel is not None:
             return self._compiled(res, r_ws, fwd, v_ws, omega_ws)
-        return self._reference(res, r_ws, fwd, v_ws, omega_ws)
+        if not self.gravitational_stiffness and up_ws is None:
+            raise InputError("ContactForces: gravitational_stiffness=False needs the track's up axis (up_ws)")
+        return self._reference(res, r_ws, fwd, v_ws, omega_ws, A_ws=A_ws,
+                               up_ws=None if up_ws is None else np.asarray(up_ws, float).reshape(n_ws, 3))
 
     def _compiled(self, res, r_ws, fwd, v_ws, omega_ws):
         shp = res.gap.shape
@@ -622,8 +662,9 @@ class ContactForces:
         d["moment"] = Mg.reshape(shp + (3,))
         return d
 
-    def _reference(self, res, r_ws, fwd, v_ws, omega_ws):
-        """The same forces from the project's reference modules (vectorised numpy)."""
+    def _reference(self, res, r_ws, fwd, v_ws, omega_ws, A_ws=None, up_ws=None):
+        """The same forces from the project's reference modules (vectorised numpy), with the
+        terms switched off that the class docstring's "Reduced models" lists."""
         from .creepage import creepages
 
         M = res.gap.size
@@ -650,16 +691,30 @@ class ContactForces:
                 zero = np.zeros(on.size)
                 xi = eta = phi = zero
                 f = CreepForces(zero, zero, zero)
-            else:
-                xi, eta, phi = creepages(P, n, fwd[iw], r_ws[iw], v_ws[iw], omega_ws[iw])
+            # the creep frame: the contact plane, or the wheelset's own (forward, axle, up) frame
+            nc = n if self.contact_angle else np.asarray(A_ws, float)[iw, :, 2]
+            if self.creep_law is not None:
+                w_c = omega_ws[iw]
+                if not self.roll_rate_creepage:  # the roll rate (about the forward axis) left out
+                    w_c = w_c - np.einsum("ij,ij->i", w_c, fwd[iw])[:, None] * fwd[iw]
+                xi, eta, phi = creepages(P, nc, fwd[iw], r_ws[iw], v_ws[iw], w_c)
+                if not self.spin_creepage:
+                    phi = np.zeros(on.size)
                 f = self.creep_law(xi, eta, phi, N, h.a, h.b, self.G, self.nu, self.mu)
-            t = fwd[iw] - np.einsum("ij,ij->i", fwd[iw], n)[:, None] * n
+                if not self.spin_creepage:  # no spin moment either (Kalker's f23, f33 terms)
+                    f = CreepForces(f.Fx, f.Fy, np.zeros(on.size))
+            t = fwd[iw] - np.einsum("ij,ij->i", fwd[iw], nc)[:, None] * nc
             t /= np.linalg.norm(t, axis=1)[:, None]
-            l = np.cross(n, t)
+            l = np.cross(nc, t)
             for k, v in zip(FORCE_KEYS, (N, f.Fx, f.Fy, f.Mz, xi, eta, phi, h.a, h.b, dd)):
                 d[k][on] = v
-            d["force"][on] = N[:, None] * n + f.Fx[:, None] * t + f.Fy[:, None] * l
-            d["moment"][on] = f.Mz[:, None] * n
+            if self.gravitational_stiffness:
+                Fn = N[:, None] * n
+            else:  # only the normal force's component along the track's up axis
+                up = up_ws[iw]
+                Fn = (N * np.einsum("ij,ij->i", n, up))[:, None] * up
+            d["force"][on] = Fn + f.Fx[:, None] * t + f.Fy[:, None] * l
+            d["moment"][on] = f.Mz[:, None] * nc
         out = {k: d[k].reshape(shp) for k in FORCE_KEYS}
         out["force"] = d["force"].reshape(shp + (3,))
         out["moment"] = d["moment"].reshape(shp + (3,))

@@ -222,6 +222,11 @@ def uic60_exact(u):
 # ---------------------------------------------------------------------------------------------
 # file reading and validation
 # ---------------------------------------------------------------------------------------------
+#: Smallest lateral extent (mm) of a wheel or rail profile: a rail head is about 70 mm wide, a
+#: wheel tread and flange about 135 mm; a profile spanning less than 5 mm was given in metres.
+MIN_PROFILE_SPAN_MM = 5.0
+
+
 def _validate_xy(x, z, source):
     x = np.asarray(x, dtype=float)
     z = np.asarray(z, dtype=float)
@@ -234,6 +239,14 @@ def _validate_xy(x, z, source):
         if np.any(bad):
             i = int(np.argmax(bad))
             raise InputError(f"{source}: {name} coordinate of point {i} is {a[i]!r} (not finite)")
+    span = float(np.ptp(x))
+    if span < MIN_PROFILE_SPAN_MM and float(np.max(np.abs(np.concatenate([x, z])))) < 1.0:
+        raise InputError(
+            f"{source}: values look like metres (the lateral coordinate spans {span:.4g}, the heights "
+            f"{float(np.ptp(z)):.4g}); profile files are in mm: multiply by 1000")
+    if span < MIN_PROFILE_SPAN_MM:
+        raise InputError(f"{source}: the lateral coordinate spans only {span:.4g} mm; a wheel or rail "
+                         f"profile spans tens of mm (the values are in mm)")
     dx = np.diff(x)
     if np.all(dx < 0):
         x, z = x[::-1], z[::-1]

@@ -61,6 +61,7 @@ EN 13848-1:2019, Track geometry quality (gauge measured 14 mm below the running 
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -88,75 +89,171 @@ __all__ = [
 ]
 
 
+def _parse_segment(seg, names):
+    """Numbers in m, or strings with a unit (``Curve("200 m", "1.2 km", cant="150 mm")``),
+    converted to floats; the ranges are checked by :class:`Track` (naming the segment)."""
+    from core.inputs import parse_quantity
+
+    for name in names:
+        raw = getattr(seg, name)
+        if isinstance(raw, (float, int)) and not isinstance(raw, bool):
+            object.__setattr__(seg, name, float(raw))
+            continue
+        object.__setattr__(seg, name, float(parse_quantity(raw, "m", where=f"{type(seg).__name__}({name}=...)")))
+
+
 @dataclass(frozen=True)
 class Straight:
-    """Straight track of ``length`` (m)."""
+    """Straight track of ``length`` (m; a number in m or a string with a unit)."""
 
     length: float
+
+    def __post_init__(self):
+        _parse_segment(self, ("length",))
 
 
 @dataclass(frozen=True)
 class Curve:
-    """Circular curve: ``radius`` (m, > 0 turns left, < 0 right), cant height ``cant`` (m)."""
+    """Circular curve: ``radius`` (m, > 0 turns left, < 0 right), cant height ``cant`` (m).
+
+    Numbers are in m; strings carry a unit (``Curve("200 m", "1.2 km", cant="150 mm")``).
+    :class:`Track` checks the radius (magnitude), cant and length against their plausible
+    ranges (``data/railway/plausible_ranges.csv``: curve_radius, cant, track_segment_length).
+    """
 
     length: float
     radius: float
     cant: float = 0.0
 
+    def __post_init__(self):
+        _parse_segment(self, ("length", "radius", "cant"))
+
 
 @dataclass(frozen=True)
 class Transition:
-    """Clothoid transition: curvature and cant change linearly between its neighbours."""
+    """Clothoid transition: curvature and cant change linearly between its neighbours; its
+    ``length`` (m) is checked by :class:`Track` against the plausible range transition_length."""
 
     length: float
+
+    def __post_init__(self):
+        _parse_segment(self, ("length",))
 
 
 @dataclass
 class Irregularities:
     """Lateral (alignment) and vertical (level) centreline irregularities y_i(s), z_i(s) (m).
 
-    Zero outside [s[0], s[-1]]; the table should start and end at zero.
+    Zero outside [s[0], s[-1]]; the table should start and end at zero (else an
+    :class:`railway.ranges.IrregularityStepWarning`: the centreline steps there).  The
+    amplitudes and the arc-length step are checked against their plausible ranges
+    (irregularity_amplitude, irregularity_sample_spacing in ``data/railway/plausible_ranges.csv``),
+    so that millimetres given as metres are refused with the slip named; ``accept`` waives a
+    range, ``source`` names the table in messages.
     """
 
     s: np.ndarray
     lateral: np.ndarray
     vertical: np.ndarray
+    source: str = "irregularities"
+    accept: tuple = ()
 
     def __post_init__(self):
-        self.s = np.asarray(self.s, dtype=float)
-        self.lateral = np.asarray(self.lateral, dtype=float)
-        self.vertical = np.asarray(self.vertical, dtype=float)
+        src = self.source
+        cols = {}
+        for name in ("s", "lateral", "vertical"):
+            raw = getattr(self, name)
+            try:
+                a = np.asarray(raw, dtype=float)
+            except (TypeError, ValueError):
+                raise InputError(f"{src}: column {name} must be numbers in m, got {raw!r:.60}") from None
+            cols[name] = a
+        self.s, self.lateral, self.vertical = cols["s"], cols["lateral"], cols["vertical"]
         for name, a in (("s", self.s), ("lateral", self.lateral), ("vertical", self.vertical)):
             if a.ndim != 1 or a.size != self.s.size:
-                raise InputError(f"irregularities: column {name} must be 1-D of length {self.s.size}")
+                raise InputError(f"{src}: column {name} must be 1-D of length {self.s.size}, got shape {a.shape}")
             bad = ~np.isfinite(a)
             if np.any(bad):
                 i = int(np.argmax(bad))
-                raise InputError(f"irregularities: {name}[{i}] = {a[i]!r} is not finite")
+                raise InputError(f"{src}: {name}[{i}] = {a[i]!r} is not finite")
         if self.s.size < 4:
-            raise InputError("irregularities: at least 4 rows are needed")
+            raise InputError(f"{src}: at least 4 rows are needed, got {self.s.size}")
         d = np.diff(self.s)
         if np.any(d <= 0):
             i = int(np.argmax(d <= 0)) + 1
-            raise InputError(f"irregularities: s must increase strictly; s[{i}] = {self.s[i]!r}")
+            raise InputError(f"{src}: s must increase strictly; s[{i}] = {self.s[i]!r}")
+        from .ranges import IrregularityStepWarning, ranges
+
+        R = ranges()
+        acc = [self.accept] if isinstance(self.accept, str) else list(self.accept)
+        units = getattr(self, "_units", {})
+        for name, a, q in (("s step", d, "irregularity_sample_spacing"),
+                           ("lateral", self.lateral, "irregularity_amplitude"),
+                           ("vertical", self.vertical, "irregularity_amplitude")):
+            r = R[q]
+            out = ~((a >= r.low) & (a <= r.high))
+            if q in acc or not np.any(out):
+                continue
+            i = int(np.argmax(np.where(out, np.abs(a), -1.0)))  # the largest value out of range
+            col = name.split()[0]
+            unit = units.get(col, "m")
+            head = f" (column '{col} [{unit}]')" if units else ""
+            written = float(a[i]) * (1e3 if unit == "mm" else 1.0)  # the number as written
+            R.check(q, written, unit=unit, where=f"{src}{head} {name}[{i}]", accept=acc)
+        for name, a in (("lateral", self.lateral), ("vertical", self.vertical)):
+            ends = [(k, a[k]) for k in (0, -1) if abs(a[k]) > 1e-4]
+            if ends:
+                k, v = ends[0]
+                warnings.warn(f"{src}: {name} irregularity is {v * 1e3:.3g} mm at s = {self.s[k]:g} m, the "
+                              f"{'start' if k == 0 else 'end'} of the table (zero outside it): the centreline "
+                              f"steps by that much there; taper the table to zero",
+                              IrregularityStepWarning, stacklevel=3)
+                break  # one warning per table
 
     @classmethod
-    def from_csv(cls, path):
-        """Read columns ``s [m]``, ``lateral [m]``, ``vertical [m]`` (header required; mm columns
-        named ``lateral [mm]`` / ``vertical [mm]`` are converted)."""
+    def from_csv(cls, path, accept=()):
+        """Read columns ``s [m]``, ``lateral [m]``, ``vertical [m]`` (header required; columns
+        in mm named ``s [mm]``, ``lateral [mm]``, ``vertical [mm]`` are converted).  Values
+        outside the plausible amplitudes are refused naming the column's header and the likely
+        slip (mm written under a header in m); ``accept`` waives a range."""
         import pandas as pd
+        from core.errors import DataFileError
 
-        df = pd.read_csv(path)
+        try:
+            df = pd.read_csv(path)
+        except FileNotFoundError:
+            raise DataFileError(f"irregularity file {path} does not exist") from None
+        except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+            raise DataFileError(f"irregularity file {path}: not a CSV table ({str(exc).strip()[:100]})") from None
         cols = {c.strip().lower(): c for c in df.columns}
+        units = {}
 
         def col(base):
-            for unit, f in (("[m]", 1.0), ("[mm]", 1e-3)):
-                key = f"{base} {unit}"
+            for unit, f in (("m", 1.0), ("mm", 1e-3)):
+                key = f"{base} [{unit}]"
                 if key in cols:
-                    return df[cols[key]].to_numpy(float) * f
-            raise InputError(f"{path}: missing column '{base} [m]' (or [mm]); found {list(df.columns)}")
+                    units[base] = unit
+                    try:
+                        return pd.to_numeric(df[cols[key]], errors="raise").to_numpy(float) * f
+                    except (ValueError, TypeError):
+                        bad = pd.to_numeric(df[cols[key]], errors="coerce").isna().to_numpy()
+                        i = int(np.argmax(bad))
+                        raise DataFileError(f"{path}: column '{cols[key]}' row {i + 1}: "
+                                            f"{df[cols[key]].iloc[i]!r} is not a number") from None
+            unitless = [c for c in df.columns if c.strip().lower() == base]
+            hint = (f"; column '{unitless[0]}' has no unit: name it '{base} [m]' or '{base} [mm]'"
+                    if unitless else "")
+            from core.inputs import closest
 
-        return cls(col("s"), col("lateral"), col("vertical"))
+            hint = hint or closest(f"{base} [m]", list(df.columns))
+            raise DataFileError(f"{path}: missing column '{base} [m]' (or [mm]){hint}; found {list(df.columns)}")
+
+        s, lat, ver = col("s"), col("lateral"), col("vertical")
+        obj = cls.__new__(cls)
+        obj.s, obj.lateral, obj.vertical, obj.source, obj.accept = s, lat, ver, str(path), tuple(accept)
+        obj._units = units
+        obj.__post_init__()
+        return obj
 
 
 @dataclass
@@ -221,6 +318,9 @@ class Track(FramedCurve):
         Largest interval of the internal piecewise-polynomial table (m).
     origin : (3,) array_like, heading : float
         Start point (m) and heading (rad) of the centreline.
+    accept : sequence of str
+        Quantities whose plausible range is not enforced (curve_radius, cant, transition_length,
+        track_segment_length, cant_base; ``data/railway/plausible_ranges.csv``).
 
     Attributes
     ----------
@@ -238,8 +338,11 @@ class Track(FramedCurve):
     closed = False
 
     def __init__(self, segments, cant_base=1.5, irregularities=None, max_step=2.0,
-                 origin=(0.0, 0.0, 0.0), heading=0.0):
+                 origin=(0.0, 0.0, 0.0), heading=0.0, accept=()):
         segments = list(segments)
+        if irregularities is not None and not isinstance(irregularities, Irregularities):
+            raise InputError(f"track: irregularities must be an Irregularities table (Irregularities(s, "
+                             f"lateral, vertical) or Irregularities.from_csv(path)), got {type(irregularities).__name__}")
         if not segments:
             raise InputError("track: at least one segment is needed")
         for i, seg in enumerate(segments):
@@ -251,7 +354,11 @@ class Track(FramedCurve):
                 if not (np.isfinite(seg.radius) and seg.radius != 0):
                     raise InputError(f"track: segment {i} radius {seg.radius!r} must be finite, non-zero")
                 if not (np.isfinite(seg.cant) and 0.0 <= seg.cant < cant_base):
-                    raise InputError(f"track: segment {i} cant {seg.cant!r} m must be in [0, {cant_base})")
+                    raise InputError(f"track: segment {i} cant {seg.cant!r} m must be in [0, {cant_base})"
+                                     + (": the cant is the height of the outer rail (>= 0), the direction of "
+                                        "the curve the sign of the radius" if seg.cant < 0 else
+                                        f": did you mean {seg.cant:g} mm?" if seg.cant >= 1 else ""))
+        self._check_ranges(segments, cant_base, accept)
         self.segments = segments
         self.cant_base = float(cant_base)
         self.irregularities = irregularities
@@ -293,6 +400,24 @@ class Track(FramedCurve):
             grid = np.unique(np.concatenate([grid, knots]))
         self._spline = spline
         self._build(grid, origin)
+
+    @staticmethod
+    def _check_ranges(segments, cant_base, accept):
+        """Plausible ranges of the segments (``data/railway/plausible_ranges.csv``) and of the cant
+        base; ``accept`` waives a quantity (e.g. ``accept=["curve_radius"]``)."""
+        from .ranges import ranges
+
+        R = ranges()
+        accept = [accept] if isinstance(accept, str) else list(accept)
+        R.check("cant_base", cant_base, where="track: cant_base", accept=accept)
+        for i, seg in enumerate(segments):
+            kind = type(seg).__name__
+            where = f"track: segment {i} ({kind})"
+            R.check("transition_length" if kind == "Transition" else "track_segment_length", seg.length,
+                    where=f"{where} length", accept=accept)
+            if kind == "Curve":
+                R.check("curve_radius", abs(seg.radius), where=f"{where} radius", accept=accept)
+                R.check("cant", seg.cant, where=f"{where} cant", accept=accept)
 
     @classmethod
     def straight(cls, length=1000.0, **kw):
@@ -434,7 +559,7 @@ class Track(FramedCurve):
 
 
 def parse_inclination(value):
-    """Rail inclination as tan(alpha) >= 0 from 0.025, "1:40", "1:20" or "vertical".
+    """Rail inclination as tan(alpha) >= 0 from 0.025, "1:40", "1/40", "1:20" or "vertical".
 
     A negative value (rail tilted away from the track centre) is rejected.
     """
@@ -443,8 +568,8 @@ def parse_inclination(value):
         v = value.strip().lower()
         if v in ("vertical", "0", "none"):
             return 0.0
-        if ":" in v:
-            num, den = v.split(":", 1)
+        if ":" in v or "/" in v:
+            num, den = v.split(":" if ":" in v else "/", 1)
             try:
                 value = float(num) / float(den)
             except (ValueError, ZeroDivisionError):
@@ -464,7 +589,11 @@ def parse_inclination(value):
             + " is negative: rails are inclined towards the track "
             "centre, give tan(alpha) >= 0 (e.g. 1/40 = 0.025)")
     if value > 0.2:
-        raise InputError(f"rail inclination {value!r} is implausibly large (tan alpha > 0.2)")
+        hint = (f": did you mean '1:{value:g}' (= {1 / value:.4g})?" if value >= 5 else
+                f": did you mean {value:g} degrees (tan = {np.tan(np.radians(value)):.4g})?" if value <= 5 else "")
+        raise InputError(f"rail inclination {value!r}"
+                         + (f" (given as {given!r})" if isinstance(given, str) else "")
+                         + f" is implausibly large (tan alpha > 0.2){hint}")
     return value
 
 

@@ -84,7 +84,7 @@ def conical_wheel_points(cone=1 / 40, root_radius_mm=8.0, y_min_mm=-62.0, y_max_
     Parameters
     ----------
     cone : float
-        Tread conicity c (tan of the cone angle), e.g. 1/40 or 1/20.
+        Tread conicity c (tan of the cone angle), e.g. 1/40 or 1/20; below 0.5.
     root_radius_mm : float
         Radius R of the concave flange root (mm); below 13 mm (the UIC60 gauge corner) the
         profile has two-point contact at flange onset.
@@ -98,8 +98,8 @@ def conical_wheel_points(cone=1 / 40, root_radius_mm=8.0, y_min_mm=-62.0, y_max_
     y_joint : float
         Tangent point of the root arc on the flank (mm): boundary of the convex flange zone.
     """
-    if not (0.0 < cone < 0.2):
-        raise ValueError(f"cone = {cone!r} must lie in (0, 0.2)")
+    if not (0.0 < cone < 0.5):
+        raise ValueError(f"cone = {cone!r} must lie in (0, 0.5)")
     if not (0.0 < root_radius_mm < 30.0):
         raise ValueError(f"root_radius_mm = {root_radius_mm!r} must lie in (0, 30) mm")
     rows = {name: coef for name, _, _, coef in _load_s1002()}
@@ -110,6 +110,9 @@ def conical_wheel_points(cone=1 / 40, root_radius_mm=8.0, y_min_mm=-62.0, y_max_
     Fc = R * q1 - c * yc
     y_t1 = yc - R * c / q1
     y_t2 = yc - R * BE / q2
+    if not y_t2 < y_t1:
+        raise ValueError(f"cone = {cone!r}, root_radius_mm = {root_radius_mm!r}: no concave root arc joins "
+                         "the tread to the flank")
     y = np.arange(y_min_mm, y_max_mm + 0.5 * step_mm, step_mm)
     F = np.empty_like(y)
     tread = y >= y_t1

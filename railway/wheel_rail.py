@@ -167,6 +167,13 @@ wheelset models, Wickens 2003, ch. 2).  The state is then time-invariant in stea
 core's :func:`~core.analysis.linearize` / :func:`~core.analysis.eigen` apply (scene
 ``railway-critical-speed``).  Integrated runs use the absolute spin.
 
+For like-for-like comparisons with the linear wheelset models, five options switch off what the
+classical two-degree-of-freedom wheelset neglects: ``gyroscopic`` (the moment above),
+``roll_rate_creepage``, ``gravitational_stiffness`` (the tilt of the normal forces),
+``contact_angle`` (creep in the wheelset's frame) and ``spin_creepage`` (see
+:class:`railway.forces.ContactForces`, "Reduced models", and :class:`railway.hunting.LinearWheelset`,
+which has the same five terms).  All are on by default.
+
 Loss of contact and derailment
 ------------------------------
 A wheel that lifts off has no penetration and gets zero force.  After every accepted step the
@@ -196,13 +203,17 @@ from typing import Any
 import numpy as np
 
 from core import frames
-from core.errors import ModelError, NumericalFailure
+from core.errors import DataRangeError, InputError, ModelError, NumericalFailure
 from core.forces.protocol import ForceElement, ForceEval, ForceJacobian, ForceKind
 
 from .contact_search import ContactSearch
 from .forces import ContactForces
 from .profiles import WheelProfile
 from .track import RailMounting
+
+#: A wheelset that leaves an open track within this distance (m) of an end ran past that end (a
+#: step moves it by far less); elsewhere it left the rails.
+END_MARGIN = 10.0
 
 __all__ = ["WheelRailContact", "WheelRailKind", "contact_history"]
 
@@ -260,6 +271,14 @@ class WheelRailContact(ForceElement):
         Omega [rad/s] about the axle, not integrated (the body frames do not turn with it), and
         the bodies' own rotation; I_spin [kg m²] is the wheelsets' inertia about the axle.  Numpy
         path only.
+    gyroscopic : bool
+        With ``nominal_spin``: False leaves out the nominal spin's gyroscopic moment
+        −I_spin Ω (ω × a) (module docstring, "Nominal spin"); refused without ``nominal_spin``.
+    spin_creepage, roll_rate_creepage, contact_angle, gravitational_stiffness : bool
+        Terms of the contact forces (:class:`railway.forces.ContactForces`, "Reduced models"),
+        all on by default.  With ``gyroscopic`` these are the five mechanisms by which the
+        multibody wheelset differs from the classical two-degree-of-freedom wheelset;
+        :data:`railway.wheelset_models.TEXTBOOK` switches all five off.  Numpy path only.
     reseed_every : int
         Global re-seeding of the tracked contacts every this many accepted steps (default 1).
     flange_climb_height, max_lateral_displacement, max_drop : float
@@ -284,6 +303,11 @@ class WheelRailContact(ForceElement):
     approach_velocity_floor: float = 0.1
     rail_body: Any = None
     nominal_spin: Any = None
+    gyroscopic: bool = True
+    spin_creepage: bool = True
+    roll_rate_creepage: bool = True
+    contact_angle: bool = True
+    gravitational_stiffness: bool = True
     reseed_every: int = 1
     flange_climb_height: float = 5e-3
     max_lateral_displacement: float = 0.05
@@ -348,6 +372,9 @@ class _Set:
                 raise ModelError(f"wheel-rail contact {e.name!r}: nominal_spin = {e.nominal_spin!r} needs a finite "
                                  "rate and a positive spin inertia")
             self.spin = (Om, Iy)
+        if not e.gyroscopic and self.spin is None:
+            raise ModelError(f"wheel-rail contact {e.name!r}: gyroscopic=False needs the nominal-spin formulation "
+                             "(nominal_spin); a spinning body's gyroscopic moment is part of its own dynamics")
         self.cs = ContactSearch(e.track, wheel=wheel, rails=rails, n_wheelsets=len(names),
                                 flange_back_spacing=e.flange_back_spacing, n_seeds=2, tol=1e-11,
                                 tol_linear=1e-11)
@@ -355,7 +382,9 @@ class _Set:
             self.cf = ContactForces(E=e.E, nu=e.nu, mu=e.mu, creep_model=e.creep_law,
                                     restitution=e.restitution,
                                     approach_velocity_floor=e.approach_velocity_floor,
-                                    creep_params=e.creep_params)
+                                    creep_params=e.creep_params, spin_creepage=e.spin_creepage,
+                                    roll_rate_creepage=e.roll_rate_creepage, contact_angle=e.contact_angle,
+                                    gravitational_stiffness=e.gravitational_stiffness)
         except ValueError as exc:
             raise ModelError(f"wheel-rail contact {e.name!r}: {exc}") from None
         self.wheel = wheel
@@ -398,10 +427,11 @@ class _Set:
         """Track arc length of the wheelset centres: Newton from ``s_guess`` (the last accepted
         step's), or from the nearest node of the track's frame table when there is no guess or
         the iteration from the guess does not converge (e.g. a wild Newton iterate of an
-        implicit integrator)."""
+        implicit integrator).  NaN for a wheelset beyond the ends of an open track (it has no
+        rail there: the centreline is not extrapolated)."""
         if s_guess is not None:
             try:
-                return self.track.project(r, s_guess)
+                return self._on_track(self.track.project(r, s_guess))
             except NumericalFailure:
                 pass
         nodes = self.track.frame_table.nodes
@@ -416,9 +446,28 @@ class _Set:
                     s[k] = self.track.project(r[k:k + 1], guess[k:k + 1])[0]
                 except NumericalFailure:
                     pass
-        if not getattr(self.track, "closed", False):  # beyond the ends of an open track: no rail
+        return self._on_track(s)
+
+    def _on_track(self, s):
+        """NaN where s is beyond the ends of an open track (no rail there)."""
+        if not getattr(self.track, "closed", False):
             s = np.where((s >= 0.0) & (s <= self.track.length), s, np.nan)
         return s
+
+    def off_track_message(self, k, r, s_prev):
+        """Why wheelset k has no track under it: past an end of an open track (judged from its
+        last accepted arc length ``s_prev``) or far off the rails."""
+        L = self.track.length
+        name = f"wheelset {self.wheelset_names[k]!r} ({self.name})"
+        if not getattr(self.track, "closed", False) and np.isfinite(s_prev):
+            if s_prev > L - END_MARGIN:
+                return (f"{name} ran past the end of the track at s = {L:g} m: the track is open and is not "
+                        f"extrapolated; make it longer or the run shorter")
+            if s_prev < END_MARGIN:
+                return (f"{name} ran off the start of the track at s = 0 m: the track is open and is not "
+                        f"extrapolated")
+        at = f", at {np.round(r, 3).tolist()} m" if np.all(np.isfinite(r)) else ""
+        return f"{name} is no longer over the track (far off the rails{at})"
 
     def unspun(self, A, s):
         """Wheelset frames without the spin: [f, a, u] (module docstring)."""
@@ -518,19 +567,24 @@ class _Set:
                 rr.in_contact[gone] = False
                 rr.gap[gone] = np.inf
                 rr.penetration[gone] = -np.inf
-        f = self.forces(res, r, Ans, v, w)
+        f = self.forces(res, r, Ans, v, w, s)
         return res, f, np.where(off, np.nan, s), Ans
 
-    def forces(self, res, r, Ans, v, w):
+    def forces(self, res, r, Ans, v, w, s=None):
         """Forces of the primary contacts and of the second patches (``f["secondary"]``), the
-        latter weighted by their separation from the primary (module docstring)."""
-        f = self.cf(res, r, Ans, v, w)
+        latter weighted by their separation from the primary (module docstring); ``s`` (the
+        wheelsets' arc lengths) is needed only with ``gravitational_stiffness=False``."""
+        up = None if self.cf.gravitational_stiffness else self.track.evaluate_raw(s)[3][:, :, 2]
         res2 = res.extra.get("secondary")
+        try:  # name this element in the creep forces' refusal (e.g. a rolling speed below 1e-3 m/s)
+            f = self.cf(res, r, Ans, v, w, up)
+            f2 = None if res2 is None else self.cf(res2, r, Ans, v, w, up)
+        except InputError as exc:
+            raise InputError(f"wheel-rail contact {self.e.name!r}: {exc}") from None
         if res2 is None:
             zero = {k: np.zeros_like(v_) for k, v_ in f.items()}
             f["secondary"] = zero
             return f
-        f2 = self.cf(res2, r, Ans, v, w)
         # the wheel's patches: (tread, flange) primary then (tread, flange) second
         stack = lambda a1, a2: np.concatenate([a1, a2], axis=-1)
         sh = patch_shares(stack(res.y_wheel, res2.y_wheel), stack(res.gap, res2.gap), stack(f["b"], f2["b"]),
@@ -564,7 +618,7 @@ class _Set:
         r, A, v, w = self.states(bs)
         res, f, _, _ = self.contacts(r, A, v, w, s)
         Ft, Mt, p, F, M = self.generalized(r, A, res, f)
-        if self.spin is not None:  # gyroscopic moment of the nominal spin, -I Omega (omega x a)
+        if self.spin is not None and self.e.gyroscopic:  # gyroscopic moment of the nominal spin, -I Omega (omega x a)
             Om, Iy = self.spin
             a = A[:, :, 1]
             w_body = w - Om * a
@@ -674,15 +728,14 @@ class WheelRailKind(ForceKind):
             s = st._project(r, state.s_ws)
             if not np.all(np.isfinite(s)):
                 k = int(np.argmax(~np.isfinite(s)))
-                raise NumericalFailure(
-                    f"wheelset {st.wheelset_names[k]!r} ({st.name}) is no longer over the track (beyond "
-                    f"the end of the track or far off the rails, at {r[k].round(3).tolist()} m)")
+                msg = st.off_track_message(k, r[k], state.s_ws[k])
+                raise (DataRangeError if "of the track at" in msg else NumericalFailure)(msg)
             Ans = st.unspun(A, s)
             reseed = reseed or (state.accepted + 1) % st.e.reseed_every == 0
             res, X, G, prob = st.accept_pairs(r, Ans, s, reseed, robust=state.valid if reseed else None)
             if not reseed and np.any(state.valid & ~res.valid.ravel()):  # a tracked contact was lost
                 res, X, G, prob = st.accept_pairs(r, Ans, s, True, robust=state.valid)
-            f = st.forces(res, r, Ans, v, w)
+            f = st.forces(res, r, Ans, v, w, s)
             out = _wheel_quantities(st, res, f, r, Ans, s, w)
             if check:
                 _check_derailment(st, res, out, state.last_YQ)
@@ -983,8 +1036,15 @@ def _check_derailment(st, res, out, last_YQ):
             f"wheel {labels[i]!r}: {last(i)}")
 
 
-def contact_history(model, result, element=None, wheels=None, max_step=2e-3):
-    """Per output time and wheel, what a railway engineer reads (long format).
+#: peaks refined by :func:`contact_history` at the accepted steps: (column, kind), kind "max",
+#: "min" or "absmax" (largest magnitude)
+PEAK_COLUMNS = (("Q [N]", "max"), ("Q [N]", "min"), ("Y [N]", "absmax"), ("Y/Q [-]", "max"),
+                ("flange force [N]", "max"))
+
+
+def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at="outputs", locate_lift=None,
+                    lift_tol=1e-7, peak_samples=8):
+    """Per output time (or accepted step) and wheel, what a railway engineer reads (long format).
 
     The outputs of :meth:`WheelRailKind.contact_outputs` are evaluated at the stored states of
     ``result``, with the search state tracked along the run as the integrator tracks it: reset at
@@ -996,6 +1056,23 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3):
     patches that the run had, and a fresh global search at every row would pick the patches
     afresh where two of them share a zone -- either would misstate the forces the run applied.
 
+    ``at="steps"`` evaluates at every accepted step of a run made with
+    ``simulate(..., record_steps=True)`` (``result.steps``) instead of the output times: the
+    replay then re-seeds where the run did, and the peaks, lifts and durations read from the
+    table do not depend on the output step (:func:`railway.assessment.wheel_event_statistics`).
+    With ``locate_lift`` (default: on for ``at="steps"``) every change of a wheel between loaded
+    (Q > 0) and lifted (Q = 0) between two rows is located by bisection to ``lift_tol`` seconds on
+    the condition Q > 0 evaluated at states interpolated within the step (cubic Hermite in the
+    positions through q̇ = Z(q) v, linear in the velocities; the search state of the later row):
+    event location of Q = 0.  The located times are in ``df.attrs["lift crossings"]``: per wheel
+    a dict from the time of the row after the change to the located time.  With ``at="steps"``
+    the peaks of :data:`PEAK_COLUMNS` are refined too: around every sample that is a local
+    extreme and could, by the change to its neighbours, exceed the extreme found so far (by a
+    quarter of the larger change: a smooth peak exceeds its best sample by at most an eighth),
+    the two adjacent steps are sampled at ``peak_samples`` interpolated states each (the error of
+    a sampled peak falls with the square of the sample spacing); ``df.attrs["peaks"]`` holds per
+    wheel and column ``(kind, value, time)``.
+
     Returns
     -------
     DataFrame
@@ -1005,35 +1082,127 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3):
         ``y_wheel [m]``), per-candidate creepages and creep forces of the tread (``_tread``) and
         flange (``_flange``) candidates, and the wheelset quantities (``s [m]``, ``lateral
         displacement [m]``, ``angle of attack [rad]``, ``spin [rad/s]``, ``sum Y [N]``, ``speed
-        [m/s]``).
+        [m/s]``).  ``attrs["at"]`` says which times the rows are.
+
+    Raises
+    ------
+    core.errors.InputError
+        ``at="steps"`` for a result without recorded steps, or an unknown ``at``.
     """
     import pandas as pd
 
+    from core.errors import InputError
+
+    if at == "outputs":
+        T, Qs, Vs = result.t, result.q, result.v
+    elif at == "steps":
+        if getattr(result, "steps", None) is None:
+            raise InputError("contact_history(at='steps'): the result holds no accepted steps; run simulate(..., "
+                             "record_steps=True)")
+        T, Qs, Vs = result.steps
+    else:
+        raise InputError(f"contact_history: at must be 'outputs' or 'steps', got {at!r}")
+    if locate_lift is None:
+        locate_lift = at == "steps"
     kind = next(k for k in model.force_kinds if isinstance(k, WheelRailKind))
     st = kind._set(element)
     saved = st.state
     rows = []
+    labels = [f"{ws} {sd}" for ws in st.wheelset_names for sd in ("left", "right")]
+    crossings: dict[str, dict[float, float]] = {lab: {} for lab in labels}
+
+    def wheels_at(k, tau):  # wheel outputs at a state interpolated in the step (T[k - 1], T[k])
+        t_a, t_b = float(T[k - 1]), float(T[k])
+        q_a, v_a, q_b, v_b = (np.asarray(x, float) for x in (Qs[k - 1], Vs[k - 1], Qs[k], Vs[k]))
+        h = t_b - t_a
+        s_ = (tau - t_a) / h
+        h00, h10, h01, h11 = 2 * s_**3 - 3 * s_**2 + 1, s_**3 - 2 * s_**2 + s_, -2 * s_**3 + 3 * s_**2, s_**3 - s_**2
+        q = model.normalize(h00 * q_a + h10 * h * model.qdot(q_a, v_a) + h01 * q_b + h11 * h * model.qdot(q_b, v_b))
+        v = (1.0 - s_) * v_a + s_ * v_b
+        return kind.contact_outputs(model.body_states(q, v), float(tau), st.name)["wheels"]
+
+    def loaded_at(k, tau):
+        return wheels_at(k, tau)["Q [N]"] > 0.0
+
+    sign = {"max": lambda x: x, "min": lambda x: -x, "absmax": np.abs}
+    refine_peaks = at == "steps" and peak_samples > 0
+    best = {pc: (np.full(len(labels), -np.inf), np.full(len(labels), np.nan)) for pc in PEAK_COLUMNS}
+    recent: list[dict] = []  # the wheel outputs of the last three rows
+
+    def consider_peaks(i):  # row i - 1 a local extreme of some (column, wheel)? refine over (T[i-2], T[i])
+        a, b, c = (recent[-3], recent[-2], recent[-1])
+        todo = []
+        for pc in PEAK_COLUMNS:
+            col, kd = pc
+            f = sign[kd]
+            xa, xb, xc = (np.nan_to_num(f(np.asarray(r_[col], float)), nan=-np.inf) for r_ in (a, b, c))
+            with np.errstate(invalid="ignore"):
+                # a smooth peak exceeds its best sample by at most 1/8 of the larger change to
+                # the neighbours (a parabola sampled with the peak midway between samples): 1/4 kept
+                room = 0.25 * np.nan_to_num(np.maximum(np.abs(xb - xa), np.abs(xb - xc)), nan=0.0, posinf=0.0)
+                cand = (xb >= xa) & (xb >= xc) & np.isfinite(xb) & (xb + room > best[pc][0])
+            if cand.any():
+                todo.append((pc, np.flatnonzero(cand)))
+        if not todo:
+            return
+        samples = []
+        for k in (i - 1, i):
+            for j in range(1, peak_samples):
+                tau = float(T[k - 1]) + j / peak_samples * (float(T[k]) - float(T[k - 1]))
+                samples.append((tau, wheels_at(k, tau)))
+        samples.append((float(T[i - 1]), b))
+        for pc, ws_ in todo:
+            col, kd = pc
+            for w_ in ws_:
+                vals = np.array([np.nan_to_num(sign[kd](float(r_[col][w_])), nan=-np.inf) for _, r_ in samples])
+                j = int(np.argmax(vals))
+                if vals[j] > best[pc][0][w_]:
+                    best[pc][0][w_], best[pc][1][w_] = vals[j], samples[j][0]
+
+    prev_loaded = None
     try:
-        for i, t in enumerate(result.t):
-            bs = model.body_states(result.q[i], result.v[i])
+        for i, t in enumerate(T):
+            bs = model.body_states(Qs[i], Vs[i])
             if i == 0:
                 kind.reset_state(bs, float(t))
             else:
-                t_prev = float(result.t[i - 1])
+                t_prev = float(T[i - 1])
                 n_sub = int(np.ceil((float(t) - t_prev) / max_step))
                 for k in range(1, n_sub):
                     w = k / n_sub
-                    qk = model.normalize((1.0 - w) * np.asarray(result.q[i - 1]) + w * np.asarray(result.q[i]))
-                    vk = (1.0 - w) * np.asarray(result.v[i - 1]) + w * np.asarray(result.v[i])
+                    qk = model.normalize((1.0 - w) * np.asarray(Qs[i - 1]) + w * np.asarray(Qs[i]))
+                    vk = (1.0 - w) * np.asarray(Vs[i - 1]) + w * np.asarray(Vs[i])
                     kind.accept_step(model.body_states(qk, vk), t_prev + w * (float(t) - t_prev), reseed=True,
                                      check=False)
                 kind.accept_step(bs, float(t), reseed=True, check=False)
             out = kind.contact_outputs(bs, float(t), st.name)
+            loaded = np.asarray(out["wheels"]["Q [N]"]) > 0.0
+            if locate_lift and prev_loaded is not None and np.any(loaded != prev_loaded):
+                ta, tb = float(T[i - 1]), float(t)
+                for w_ in np.flatnonzero(loaded != prev_loaded):
+                    lo, hi = ta, tb  # the condition at lo is prev_loaded[w_], at hi loaded[w_]
+                    while hi - lo > lift_tol:
+                        mid = 0.5 * (lo + hi)
+                        if loaded_at(i, mid)[w_] == prev_loaded[w_]:
+                            lo = mid
+                        else:
+                            hi = mid
+                    crossings[labels[w_]][tb] = 0.5 * (lo + hi)
+            prev_loaded = loaded
+            if refine_peaks:
+                recent.append(out["wheels"])
+                for pc in PEAK_COLUMNS:  # every sample counts (the first, the last, a plateau)
+                    x = np.nan_to_num(sign[pc[1]](np.asarray(out["wheels"][pc[0]], float)), nan=-np.inf)
+                    better = x > best[pc][0]
+                    best[pc][0][better], best[pc][1][better] = x[better], float(t)
+                if len(recent) >= 3:
+                    consider_peaks(i)
+                    recent.pop(0)
             r, A, v, w = st.states(bs)
             speed = np.einsum("nk,nk->n", v, st.track.evaluate_raw(np.nan_to_num(out["wheelsets"]["s [m]"]))[3][:, :, 0])
             n = 2 * st.n_ws
             row = {"t [s]": np.full(n, float(t)),
-                   "wheel": [f"{ws} {sd}" for ws in st.wheelset_names for sd in ("left", "right")],
+                   "wheel": list(labels),
                    "wheelset": np.repeat(st.wheelset_names, 2), "side": ["left", "right"] * st.n_ws}
             row.update({k: np.asarray(v_) for k, v_ in out["wheels"].items()})
             for k in ("N [N]", "Fx [N]", "Fy [N]", "xi [-]", "eta [-]", "phi [1/m]"):
@@ -1048,4 +1217,13 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3):
     df = pd.concat(rows, ignore_index=True)
     if wheels is not None:
         df = df[df["wheel"].isin(wheels)].reset_index(drop=True)
+    df.attrs["at"] = at
+    if locate_lift:
+        df.attrs["lift crossings"] = {lab: c for lab, c in crossings.items() if wheels is None or lab in wheels}
+        df.attrs["lift tolerance [s]"] = float(lift_tol)
+    if refine_peaks:
+        back = {"max": 1.0, "min": -1.0, "absmax": 1.0}
+        df.attrs["peaks"] = {lab: {col: (kd, float(back[kd] * best[(col, kd)][0][w_]), float(best[(col, kd)][1][w_]))
+                                   for col, kd in PEAK_COLUMNS}
+                             for w_, lab in enumerate(labels) if wheels is None or lab in wheels}
     return df

@@ -293,7 +293,7 @@ def test_vehicle_file_errors_name_the_file_and_key(tmp_path):
     text = Path(src).read_text(encoding="utf-8")
     bad = tmp_path / "bad.toml"
     bad.write_text(text.replace("mass = 2615.0", "mass = -2615.0"), encoding="utf-8")
-    with pytest.raises(DataFileError, match=r"bad.toml \[bogie\]: mass = -2615.0 must be > 0"):
+    with pytest.raises(DataFileError, match=r"bad.toml \[bogie\] mass: bogie frame mass = -2615.0 must be > 0"):
         VehicleDefinition.from_toml(bad)
     bad.write_text(text.replace("[primary]", "[primery]"), encoding="utf-8")
     with pytest.raises(DataFileError, match=r"unknown table\(s\) \['primery'\]"):

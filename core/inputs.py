@@ -274,6 +274,8 @@ def _with_unit(v: float, unit: str) -> str:
     rather than 1.2e+06 N/m)."""
     if unit == "kg" and abs(v) >= 1000:
         return f"{_fmt(v / 1000)} t"
+    if unit == "kg*m^2" and abs(v) >= 1e4:
+        return f"{_fmt(v / 1000)} t m²"
     if unit == "1":
         return _fmt(v)
     if unit in _PREFIXED:
@@ -375,6 +377,17 @@ class RangeTable:
             msg += f" (to use it deliberately, accept={quantity!r})"
             raise ImplausibleValueError(msg, quantity=quantity, value=float(x), suggestion=slip)
         return v
+
+    def to_markdown(self) -> str:
+        """The table as GitHub Markdown (quantity, what, low, high, why), bounds with readable
+        units: the README's tables are this output, and a test keeps them equal."""
+        lines = ["| quantity | what | low | high | why |", "|---|---|---|---|---|"]
+        for r in self:
+            lo = _with_unit(r.low, r.unit) if math.isfinite(r.low) else "—"
+            hi = _with_unit(r.high, r.unit) if math.isfinite(r.high) else "—"
+            why = r.rationale.replace("|", "/")
+            lines.append(f"| `{r.quantity}` | {r.label} | {lo} | {hi} | {why} |")
+        return "\n".join(lines)
 
     def quantity(self, name: str, shape: int | None = None):
         """A pydantic field type for quantity ``name``: parses units and checks the range.

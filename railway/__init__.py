@@ -23,6 +23,8 @@ core's, :mod:`core.contact_laws`; the creep laws live in :mod:`railway.creep`):
   of a model in one call; :mod:`railway.wheel_rail_compiled` its compiled kernels);
 * :mod:`railway.vehicle` -- vehicles from a TOML file (car body, bogies, wheelsets, suspensions),
   static preload; :mod:`railway.traction` -- speed control along the track;
+* :mod:`railway.curving_start` -- the quasi-static curving state: a vehicle's start in a curve or
+  a transition at its speed (``Vehicle.equilibrium``, ``Vehicle.initial_state``);
 * :mod:`railway.hunting` -- Klingel's wavelength and the critical speed of a suspended wheelset;
 * :mod:`railway.wheelset_models` -- free and suspended single-wheelset models;
 * :mod:`railway.scenes`, :mod:`railway.vehicle_scenes` -- scenes for ``mbsuite run``.

@@ -2,7 +2,8 @@ r"""Railway vehicles from a data file: car body, bogie frames and wheelsets on t
 
 A :class:`VehicleDefinition` is read from a TOML file (``data/railway/vehicles/*.toml``; the
 format is the Manchester coach's file, documented key by key there and in
-:meth:`VehicleDefinition.from_toml`), so that a user adds a vehicle without code.
+:meth:`VehicleDefinition.from_toml`; its schema, units, plausible ranges and consistency rules
+are :mod:`railway.vehicle_file`), so that a user adds a vehicle without code.
 :func:`build_vehicle` turns it into a core model on a track:
 
 * bodies (spatial, absolute coordinates): car body, two bogie frames, four wheelsets
@@ -42,55 +43,37 @@ with the springs carrying the weight.  Its table reports the wheel loads against
 weight, m_total g / 8 per wheel for the symmetric vehicle, and the suspension deflections.  The
 dynamic runs start from this equilibrium with every body moving at the speed V along the track
 and the wheelsets spinning at V / r0.
+
+Start in a curve or a transition
+--------------------------------
+Where the track under the vehicle is not straight (:attr:`Vehicle.on_straight_track`), the start
+of a run (:meth:`Vehicle.initial_state`, :meth:`Vehicle.preload`) is the quasi-static curving
+state at s0 and the speed V (:meth:`Vehicle.equilibrium`,
+:func:`railway.curving_start.quasi_static_curving`): the equilibrium of the model's own forces
+with the accelerations of steady motion along the track (centripetal V²κ, the yaw and cant
+rates of the track frame), the creep forces of its creep law, the wheelsets rolling.  The
+suspension's unloaded geometry is always the straight design geometry: in a curve
+:func:`build_vehicle` builds the vehicle on the tangent at s0 and places it on the track, so
+that the springs are deflected by the curve (railway.curving_start, "Reference geometry").  On
+straight track nothing changes: the start is the static preload above.
 """
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from core import frames
-from core.errors import DataFileError, InputError
+from core.errors import InputError
 
-from .profiles import RailProfile, WheelProfile
 from .track import RailMounting
 
 __all__ = ["VehicleDefinition", "Vehicle", "build_vehicle", "GRAVITY"]
 
 GRAVITY = 9.81
-
-
-def _vec(d, key, n, where):
-    try:
-        v = np.asarray(d[key], dtype=float)
-    except KeyError:
-        raise DataFileError(f"{where}: missing key {key!r}") from None
-    except (TypeError, ValueError):
-        raise DataFileError(f"{where}: {key} = {d[key]!r} is not a number or list of numbers") from None
-    if v.ndim == 0:
-        v = np.full(n, float(v))
-    if v.shape != (n,) or not np.all(np.isfinite(v)) or np.any(v < 0):
-        raise DataFileError(f"{where}: {key} must be {n} finite numbers >= 0, got {d[key]!r}")
-    return v
-
-
-def _num(d, key, where, positive=True, default=None):
-    if key not in d:
-        if default is not None:
-            return float(default)
-        raise DataFileError(f"{where}: missing key {key!r}")
-    try:
-        v = float(d[key])
-    except (TypeError, ValueError):
-        raise DataFileError(f"{where}: {key} = {d[key]!r} is not a number") from None
-    if not np.isfinite(v) or (v <= 0 if positive else v < 0):
-        raise DataFileError(f"{where}: {key} = {v!r} must be {'> 0' if positive else '>= 0'}")
-    return v
 
 
 @dataclass(frozen=True)
@@ -120,8 +103,12 @@ class VehicleDefinition:
     path: str = ""
 
     @classmethod
-    def from_toml(cls, path) -> VehicleDefinition:
-        """Read a vehicle file (TOML); every error names the file and the key.
+    def from_toml(cls, path, accept=()) -> VehicleDefinition:
+        """Read a vehicle file (TOML); every error names the file, the table and the key.
+
+        The schema, units, plausible ranges and consistency rules are those of
+        :mod:`railway.vehicle_file`; ``accept`` names quantities or rules whose check is waived
+        (as the file's ``[checks] accept = [...]``).
 
         Tables and keys: ``[vehicle]`` name, source; ``[profiles]`` wheel ("S1002" or a profile
         file), rail ("UIC60" or a file), inclination, gauge [m], nominal_wheel_radius [m],
@@ -137,70 +124,18 @@ class VehicleDefinition:
         x [m: the car-body end of the longitudinal damper is x ahead of the bogie centre, the
         bogie end at the bogie centre], y [m, each side], z [m above the rail top].
         """
-        path = Path(path)
-        try:
-            with path.open("rb") as fh:
-                d = tomllib.load(fh)
-        except FileNotFoundError:
-            raise DataFileError(f"vehicle file {path} does not exist") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise DataFileError(f"vehicle file {path}: not valid TOML ({exc})") from None
-        known = {"vehicle", "profiles", "geometry", "car_body", "bogie", "wheelset", "primary", "secondary",
-                 "anti_roll_bar", "lateral_bump_stop", "yaw_damper"}
-        extra = set(d) - known
-        if extra:
-            raise DataFileError(f"vehicle file {path}: unknown table(s) {sorted(extra)}; known: {sorted(known)}")
-        for t in ("profiles", "geometry", "car_body", "bogie", "wheelset", "primary", "secondary"):
-            if t not in d:
-                raise DataFileError(f"vehicle file {path}: missing table [{t}]")
-        w = f"{path} [profiles]"
-        pr = d["profiles"]
-        r0 = _num(pr, "nominal_wheel_radius", w)
-        wheel_spec = str(pr.get("wheel", "S1002"))
-        if wheel_spec.upper() == "S1002":
-            wheel = WheelProfile.s1002(r0=r0)
-        else:
-            wheel = WheelProfile.from_file(path.parent / wheel_spec, r0=r0)
-        rail_spec = str(pr.get("rail", "UIC60"))
-        rail = RailProfile.uic60() if rail_spec.upper() == "UIC60" else RailProfile.from_file(path.parent / rail_spec)
-        geo_keys = ("bogie_centre_semi_distance", "bogie_semi_wheelbase", "primary_lateral_semi_spacing",
-                    "secondary_lateral_semi_spacing", "car_body_cg_height", "bogie_cg_height", "secondary_height")
-        geometry = {k: _num(d["geometry"], k, f"{path} [geometry]") for k in geo_keys}
+        from .vehicle_file import read_vehicle_file
 
-        def body(t):
-            where = f"{path} [{t}]"
-            return {"mass": _num(d[t], "mass", where), "inertia": _vec(d[t], "inertia", 3, where)}
+        return cls(**read_vehicle_file(path, accept=accept))
 
-        def susp(t):
-            where = f"{path} [{t}]"
-            return {"stiffness": _vec(d[t], "stiffness", 3, where), "damping": _vec(d[t], "damping", 3, where)}
+    @classmethod
+    def from_dict(cls, data: dict, *, source: str = "VehicleDefinition.from_dict()", base_dir=None,
+                  accept=()) -> VehicleDefinition:
+        """A vehicle from the tables of a vehicle file given as nested dicts (the same schema,
+        units, ranges and rules as :meth:`from_toml`; :mod:`railway.vehicle_file`)."""
+        from .vehicle_file import vehicle_kwargs
 
-        secondary = susp("secondary")
-        secondary["yaw_stiffness"] = _num(d["secondary"], "yaw_stiffness", f"{path} [secondary]",
-                                          positive=False, default=0.0)
-        arb = _num(d.get("anti_roll_bar", {}), "stiffness", f"{path} [anti_roll_bar]", positive=False,
-                   default=0.0) if "anti_roll_bar" in d else 0.0
-        bump = None
-        if "lateral_bump_stop" in d:
-            where = f"{path} [lateral_bump_stop]"
-            bs = d["lateral_bump_stop"]
-            disp = np.asarray(bs.get("displacement", []), float)
-            force = np.asarray(bs.get("force", []), float)
-            if disp.size < 2 or disp.shape != force.shape:
-                raise DataFileError(f"{where}: displacement and force must be lists of equal length >= 2")
-            bump = {"displacement": disp, "force": force}
-        yds = []
-        for i, yd in enumerate(d.get("yaw_damper", [])):
-            where = f"{path} [[yaw_damper]] {i + 1}"
-            yds.append({k: _num(yd, k, where, positive=(k not in ("x", "y", "z"))) if k not in ("x", "y")
-                        else float(yd[k]) for k in ("damping", "series_stiffness", "node_mass", "x", "y", "z")})
-        meta = d.get("vehicle", {})
-        return cls(name=str(meta.get("name", path.stem)), source=str(meta.get("source", "")), wheel=wheel,
-                   rail=rail, inclination=pr.get("inclination", "1:40"), gauge=_num(pr, "gauge", w),
-                   r0=r0, flange_back_spacing=_num(pr, "flange_back_spacing", w), geometry=geometry,
-                   car_body=body("car_body"), bogie=body("bogie"), wheelset=body("wheelset"),
-                   primary=susp("primary"), secondary=secondary, anti_roll_bar=arb, bump_stop=bump,
-                   yaw_dampers=yds, path=str(path))
+        return cls(**vehicle_kwargs(data, source=source, base_dir=base_dir, accept=accept))
 
     @classmethod
     def manchester(cls) -> VehicleDefinition:
@@ -214,7 +149,19 @@ class VehicleDefinition:
         return self.car_body["mass"] + 2 * self.bogie["mass"] + 4 * self.wheelset["mass"]
 
     def static_deflections(self, g=GRAVITY):
-        """(Δz₁ primary, Δz₂ secondary) [m] under the weight (module docstring)."""
+        """(Δz₁ primary, Δz₂ secondary) [m] under the weight (module docstring).
+
+        Raises
+        ------
+        core.errors.InputError
+            A vertical stiffness that is not positive and finite (names the suspension and value).
+        """
+        for part in ("primary", "secondary"):
+            k_z = float(getattr(self, part)["stiffness"][2])
+            if not (np.isfinite(k_z) and k_z > 0.0):
+                raise InputError(f"vehicle {self.name!r}: {part} suspension vertical stiffness k_z = {k_z!r} N/m "
+                                 f"([{part}] stiffness, z) must be positive: the static deflection m g / (4 k_z) "
+                                 "that places the bodies above their springs is undefined")
         dz1 = (0.5 * self.car_body["mass"] + self.bogie["mass"]) * g / (4.0 * self.primary["stiffness"][2])
         dz2 = self.car_body["mass"] * g / (4.0 * self.secondary["stiffness"][2])
         return dz1, dz2
@@ -240,6 +187,51 @@ class Vehicle:
     q_static: np.ndarray | None = None
     preload_table: pd.DataFrame | None = None
     _contact_options: dict | None = None
+    start: Any = None
+
+    @property
+    def on_straight_track(self) -> bool:
+        """True when the design line under all wheelsets is straight (no curvature, no cant
+        change): the vehicle then starts from the static preload (:meth:`initial_state`)."""
+        g = self.definition.geometry
+        ext = g["bogie_centre_semi_distance"] + g["bogie_semi_wheelbase"]
+        return _straight_track(self.track, self.s0 - ext, self.s0 + ext)
+
+    def equilibrium(self, tol: float = 1e-9, t0: float = 0.0) -> pd.DataFrame:
+        """The quasi-static curving state at s0 and the vehicle's speed: the start of a run
+        anywhere on the track (:func:`railway.curving_start.quasi_static_curving`).
+
+        Every body moves with the track frame at the speed V, the wheelsets roll, and the
+        forces of the model — suspension, wheel–rail contact with its creep law, speed control,
+        gravity, gyroscopic terms — balance the accelerations of that motion (centripetal
+        V²κ, the yaw and cant rates of a transition).  The state is kept in :attr:`start`
+        (a :class:`railway.curving_start.CurvingStart`) for :meth:`initial_state`.
+
+        Returns
+        -------
+        DataFrame
+            One row per wheel: ``Q [N]``, ``Y [N]``, ``Y/Q [-]``, ``flange contact``,
+            ``flange force [N]``, ``Fx [N]``, ``Fy [N]`` (creep forces), ``contact angle [rad]``,
+            ``lateral displacement [m]``, ``angle of attack [rad]``, ``sum Y [N]`` of the
+            wheelset; ``attrs["bodies"]`` (pose of every body relative to the track frame),
+            ``attrs["balance"]`` (lateral force balance of the whole vehicle) and
+            ``attrs["start"]`` (the CurvingStart).
+
+        Raises
+        ------
+        core.errors.InputError
+            A start that is impossible (no creep law, speed not > 0, overturning, a lifted
+            wheel, no steady state), naming s0, the speed and the reason.
+        """
+        from .curving_start import quasi_static_curving
+
+        st = quasi_static_curving(self, t0=t0, tol=tol)
+        self.start = st
+        table = st.wheels.copy()
+        table.attrs["bodies"] = st.bodies
+        table.attrs["balance"] = st.balance
+        table.attrs["start"] = st
+        return table
 
     @property
     def contact_kind(self):
@@ -256,7 +248,10 @@ class Vehicle:
 
         Solved on a copy of the model with normal contact forces only (no creep: the vehicle is
         at rest) and without speed control; the equilibrium positions are kept in
-        :attr:`q_static` for the dynamic runs (:meth:`initial_state`).
+        :attr:`q_static` for the dynamic runs (:meth:`initial_state`).  In a curve or a
+        transition at a speed > 0 the vehicle is not at rest: the preload is then the
+        quasi-static curving state (:meth:`equilibrium`), reported in the same table
+        (``attrs["equilibrium"]`` is its :class:`railway.curving_start.CurvingStart`).
 
         Returns
         -------
@@ -264,14 +259,33 @@ class Vehicle:
             One row per wheel: ``Q [N]`` (wheel load), ``share [N]`` (m_total g / 8),
             ``relative difference [-]``; and per suspension element its static deflection
             (``attrs["deflections"]``, a DataFrame: element, dx, dy, dz [m], Fz [N]).
+
+        Raises
+        ------
+        core.errors.InputError
+            At rest (speed 0) in a curve or transition when the static equilibrium without
+            creep forces does not exist (a canted track: nothing holds the vehicle on the
+            cant); in a curve at speed, as :meth:`equilibrium`.
         """
         from core.analysis import static_equilibrium
 
+        if not self.on_straight_track and self.speed > 0:
+            return self._preload_in_curve(tol)
         static = build_vehicle(self.definition, self.track, self.s0, 0.0, creep_law=None,
                                lateral=0.0, unloaded=True, name=f"{self.model.name} (static)",
                                contact_options=self._contact_options, parking=True)
         m = static.model
-        eq = static_equilibrium(m, q_guess=static._hertz_guess(), method="newton", tol=tol)
+        try:
+            eq = static_equilibrium(m, q_guess=static._hertz_guess(), method="newton", tol=tol)
+        except RuntimeError as exc:
+            if self.on_straight_track:
+                raise
+            raise InputError(f"preload of {self.model.name!r} at s0 = {self.s0:g} m, speed = {self.speed:g} m/s: "
+                             f"a vehicle at rest in a curve or transition is held by static friction, which the "
+                             f"model's contact (normal forces only at rest) does not have, and the static "
+                             f"equilibrium did not converge ({exc}); give the vehicle a speed > 0 (its start is "
+                             f"then the quasi-static curving state, Vehicle.equilibrium) or start on straight "
+                             f"track") from None
         zero = np.zeros(m.n_v)
         bs = m.body_states(eq.q, zero)
         kind = static.contact_kind
@@ -293,6 +307,34 @@ class Vehicle:
         table.attrs["deflections"] = pd.DataFrame(rows)
         table.attrs["equilibrium"] = eq
         self.q_static = eq.q
+        self.preload_table = table
+        return table
+
+    def _preload_in_curve(self, tol):
+        """:meth:`preload` in a curve or transition: the quasi-static curving state at the
+        vehicle's speed (:meth:`equilibrium`, reused when already solved to ``tol``), reported
+        like the static preload."""
+        if self.start is None or not self.start.residual <= tol:
+            self.equilibrium(tol=tol)
+        st = self.start
+        m = self.model
+        bs = m.body_states(st.q, st.v)
+        share = self.definition.total_mass * GRAVITY / 8.0
+        Qw = st.wheels["Q [N]"].to_numpy()
+        table = pd.DataFrame({"wheel": self.wheel_names, "Q [N]": Qw, "share m g / 8 [N]": share,
+                              "relative difference [-]": Qw / share - 1.0})
+        rows = []
+        for k in m.force_kinds:
+            if type(k).__name__ != "BushingKind":
+                continue
+            o = k.outputs(bs, 0.0)
+            for i, nm in enumerate(k.names):
+                rows.append({"element": nm, "dx [m]": o["dx [m]"][i], "dy [m]": o["dy [m]"][i],
+                             "dz [m]": o["dz [m]"][i], "Fx [N]": o["Fx [N]"][i], "Fy [N]": o["Fy [N]"][i],
+                             "Fz [N]": o["Fz [N]"][i], "My [N m]": o["My [N m]"][i]})
+        table.attrs["deflections"] = pd.DataFrame(rows)
+        table.attrs["equilibrium"] = st
+        self.q_static = st.q
         self.preload_table = table
         return table
 
@@ -324,9 +366,20 @@ class Vehicle:
         return q
 
     def initial_state(self, lateral=0.0, yaw=0.0, wheelset_lateral=None):
-        """(q0, v0): the static equilibrium (:meth:`preload`, computed if needed) moving at the
-        vehicle's speed along the track, wheelsets spinning at V / r0; optional lateral offsets
-        (m) of all bodies and of the wheelsets, and a yaw angle (rad) of the wheelsets."""
+        """(q0, v0): the start of a run at s0 and the vehicle's speed, wherever s0 lies.
+
+        On straight track: the static equilibrium (:meth:`preload`, computed if needed) moving
+        at the vehicle's speed along the track, wheelsets spinning at V / r0.  In a curve or a
+        transition (:attr:`on_straight_track` False) and at a speed > 0: the quasi-static curving
+        state (:meth:`equilibrium`, computed if needed) — lateral shifts, yaw and roll of the
+        bodies, suspension deflections and creep forces of steady curving, every body moving
+        with the track frame (its yaw rate V κ and, in a transition, the cant rate), the
+        wheelsets rolling.  Optional lateral offsets (m) of all bodies and of the wheelsets, and
+        a yaw angle (rad) of the wheelsets, are added to either (positions only)."""
+        if not self.on_straight_track and self.speed > 0:
+            if self.start is None:
+                self.equilibrium()
+            return self._offset(self.start.q.copy(), self.start.v.copy(), lateral, yaw, wheelset_lateral)
         if self.q_static is None:
             self.preload()
         m = self.model
@@ -352,6 +405,26 @@ class Vehicle:
                 v[vs.start + 3:vs.stop] = np.array([0.0, self.speed / self.definition.r0, 0.0])
         return q, v
 
+    def _offset(self, q, v, lateral, yaw, wheelset_lateral):
+        """Lateral offsets along the track's lateral axis and a wheelset yaw about its up axis,
+        at each body's nearest track point (positions only; :meth:`initial_state`)."""
+        wl = np.zeros(4) if wheelset_lateral is None else np.asarray(wheelset_lateral, float)
+        if not lateral and not yaw and not np.any(wl):
+            return q, v
+        m = self.model
+        for name in [self.car_body] + self.bogies + self.wheelsets:
+            qs = m.q_slice(name)
+            r = q[qs][:3]
+            s = self.track.project(r[None, :], np.array([self.s0]))
+            R = self.track.evaluate(s).R[0]
+            dy = lateral + (wl[self.wheelsets.index(name)] if name in self.wheelsets else 0.0)
+            q[qs.start:qs.start + 3] = r + dy * R[:, 1]
+            if name in self.wheelsets and yaw:
+                A = frames.euler_to_matrix(q[qs][3:])
+                Rz = frames.euler_to_matrix(frames.rotation_vector_to_euler(yaw * R[:, 2]))
+                q[qs.start + 3:qs.stop] = frames.matrix_to_euler(Rz @ A)
+        return q, v
+
 
 def _placement(track, s, y, z):
     """Global position and rotation of a body at arc length s, lateral y, height z (track frame)."""
@@ -360,10 +433,147 @@ def _placement(track, s, y, z):
     return fr.position[0] + R @ np.array([0.0, y, z]), R
 
 
+def _straight_track(track, s_lo, s_hi):
+    """True when the design line is straight over [s_lo, s_hi] (zero Darboux vector: no
+    curvature, no cant change; irregularities do not count)."""
+    s = np.linspace(s_lo, s_hi, max(3, int(np.ceil((s_hi - s_lo) / 0.5)) + 1))
+    return bool(np.all(np.abs(track.evaluate(s).omega) <= 1e-12))
+
+
+def _place_on_track(model, on_track, speed):
+    """The model (built in the straight reference geometry) with its initial state on the
+    track: each body at its own arc length, moving at ``speed`` along the tangent there, the
+    wheelsets spinning at the build's rate about their axle."""
+    q, v = model.q0.copy(), model.v0.copy()
+    for nm, ((pos, R), omega_axle) in on_track.items():
+        qs, vs = model.q_slice(nm), model.v_slice(nm)
+        q[qs] = np.concatenate([pos, frames.matrix_to_euler(R)])
+        v[vs] = np.concatenate([speed * R[:, 0], [0.0, omega_axle, 0.0]])
+    return model.with_state(q, v)
+
+
+#: keyword arguments of WheelRailContact that build_vehicle sets itself
+_SET_BY_BUILD = ("name", "wheelsets", "track", "wheel", "rails", "flange_back_spacing", "creep_law",
+                 "creep_params", "mu")
+
+
+def _check_definition_values(D, where):
+    """The values a model cannot be built from, in a definition made or changed in code (a file
+    is checked fully when read, :mod:`railway.vehicle_file`): masses, inertias, the geometry and
+    the wheel radius must be positive, stiffnesses and damping non-negative, everything finite."""
+    items = [(f"{b}['mass']", getattr(D, b)["mass"], True) for b in ("car_body", "bogie", "wheelset")]
+    items += [(f"{b}['inertia'][{i}]", x, True) for b in ("car_body", "bogie", "wheelset")
+              for i, x in enumerate(np.ravel(getattr(D, b)["inertia"]))]
+    for s in ("primary", "secondary"):
+        for key in ("stiffness", "damping"):
+            vals = np.ravel(getattr(D, s)[key])
+            if vals.size != 3:
+                raise InputError(f"{where}: definition.{s}[{key!r}] must have 3 values (x, y, z), got {vals.size}")
+            # (a vertical stiffness that is not positive is named by VehicleDefinition.static_deflections)
+            items += [(f"{s}[{key!r}][{i}]", x, False) for i, x in enumerate(vals)
+                      if not (key == "stiffness" and i == 2)]
+    items += [("r0", D.r0, True), ("gauge", D.gauge, True), ("anti_roll_bar", D.anti_roll_bar, False),
+              ("secondary['yaw_stiffness']", D.secondary.get("yaw_stiffness", 0.0), False)]
+    items += [(f"geometry[{k!r}]", v, True) for k, v in D.geometry.items()]
+    for name, x, positive in items:
+        x = float(x)
+        if not np.isfinite(x) or x < 0 or (positive and x == 0):
+            raise InputError(f"{where}: definition.{name} = {x!r} must be {'> 0' if positive else '>= 0'} and "
+                             f"finite")
+
+
+def _check_build_arguments(D, track, s0, speed, creep_law, creep_params, mu, lateral, wheelset_lateral,
+                           speed_control, control_gain, contact_options, accept):
+    """The arguments of :func:`build_vehicle`, checked once (units parsed, ranges, names):
+    (s0, speed, mu, lateral, wheelset_lateral, speed_control, control_gain) in SI."""
+    import dataclasses
+
+    from core.errors import UnknownNameError
+    from core.inputs import check_keywords, closest, parse_quantity
+
+    from .ranges import ranges
+    from .wheel_rail import WheelRailContact
+
+    R = ranges()
+    where = "build_vehicle"
+    if isinstance(accept, str):
+        accept = [accept]
+    accept = list(accept)
+    for a in accept:
+        if a not in R:
+            raise InputError(f"{where}(accept=...): {a!r} is not a quantity of {R.source}"
+                             f"{closest(a, [r.quantity for r in R])}")
+    if not isinstance(D, VehicleDefinition):
+        hint = " (read the file with VehicleDefinition.from_toml(path))" if isinstance(D, (str, bytes)) or \
+            hasattr(D, "__fspath__") else ""
+        raise InputError(f"{where}: definition must be a VehicleDefinition, got {type(D).__name__}{hint}")
+    if not (hasattr(track, "length") and hasattr(track, "evaluate")):
+        raise InputError(f"{where}: track must be a railway.track.Track (or a core.curves.FramedCurve), "
+                         f"got {type(track).__name__}")
+    _check_definition_values(D, where)
+    for arg, val in (("s0", s0), ("speed", speed), ("mu", mu), ("lateral", lateral)):
+        if np.ndim(val) != 0 or val is None:
+            raise InputError(f"{where}({arg}=...): one number (or a string with a unit), got {val!r}")
+    s0 = float(parse_quantity(s0, "m", where=f"{where}(s0=...)"))
+    speed = float(R.check("speed", speed, where=f"{where}(speed=...)", accept=accept))
+    mu = float(R.check("friction_coefficient", mu, where=f"{where}(mu=...)", accept=accept))
+    lateral = float(R.check("vehicle_lateral_offset", lateral, where=f"{where}(lateral=...)", accept=accept))
+    if wheelset_lateral is not None:
+        if np.ndim(wheelset_lateral) != 1 or len(wheelset_lateral) != 4:
+            raise InputError(f"{where}(wheelset_lateral=...): must be 4 values (leading wheelset first), "
+                             f"got {wheelset_lateral!r}")
+        wheelset_lateral = np.asarray(R.check("vehicle_lateral_offset", list(wheelset_lateral),
+                                              where=f"{where}(wheelset_lateral=...)", accept=accept), float)
+    if isinstance(speed_control, (str, int, float)) and not isinstance(speed_control, bool):
+        speed_control = float(R.check("speed", speed_control, where=f"{where}(speed_control=...)", accept=accept))
+    elif isinstance(speed_control, bool) or not (speed_control is None or callable(speed_control)):
+        raise InputError(f"{where}(speed_control=...): a speed (m/s, or a string with a unit), a function "
+                         f"V(t) or a TimeFunction, got {speed_control!r}")
+    if control_gain is not None:
+        control_gain = float(parse_quantity(control_gain, "N*s/m", where=f"{where}(control_gain=...)"))
+        if control_gain <= 0:
+            raise InputError(f"{where}(control_gain=...): {control_gain:g} N s/m must be > 0")
+    if isinstance(creep_law, str):
+        from .creep import _ALIASES, CREEP_MODELS
+
+        key = creep_law.strip().lower().replace("-", "_")
+        if _ALIASES.get(key, key) not in CREEP_MODELS:
+            names = list(CREEP_MODELS) + list(_ALIASES)
+            raise UnknownNameError(f"{where}(creep_law=...): unknown creep law {creep_law!r}{closest(key, names)} "
+                                   f"(registered: {', '.join(CREEP_MODELS)})")
+    if creep_params is not None and not isinstance(creep_params, dict):
+        raise InputError(f"{where}(creep_params=...): a dict of the creep law's parameters, got {creep_params!r}")
+    if creep_params:
+        import inspect
+
+        from .creep import _ALIASES, CREEP_MODELS, CreepModel
+
+        if isinstance(creep_law, CreepModel):
+            raise InputError(f"{where}(creep_params=...): parameters {sorted(creep_params)} given with a creep law "
+                             f"instance {creep_law!r}; give them to its constructor")
+        if isinstance(creep_law, str):
+            key = creep_law.strip().lower().replace("-", "_")
+            cls = CREEP_MODELS[_ALIASES.get(key, key)]
+        else:
+            cls = creep_law
+        if isinstance(cls, type):
+            sig = inspect.signature(cls.__init__).parameters
+            if not any(p.kind is p.VAR_KEYWORD for p in sig.values()):
+                check_keywords(creep_params, [n for n in sig if n != "self"],
+                               where=f"{where}(creep_params=...) of {cls.__name__}")
+    if contact_options is not None:
+        if not isinstance(contact_options, dict):
+            raise InputError(f"{where}(contact_options=...): a dict of WheelRailContact options, "
+                             f"got {contact_options!r}")
+        allowed = [f.name for f in dataclasses.fields(WheelRailContact) if f.name not in _SET_BY_BUILD]
+        check_keywords(contact_options, allowed, where=f"{where}(contact_options=...)")
+    return s0, speed, mu, lateral, wheelset_lateral, speed_control, control_gain
+
+
 def build_vehicle(definition: VehicleDefinition, track, s0: float, speed: float = 0.0, *,
                   creep_law="kalker_linear", creep_params=None, mu=0.3, lateral=0.0,
                   wheelset_lateral=None, speed_control=None, control_gain=None, unloaded=True,
-                  contact_options=None, name="vehicle", parking=False) -> Vehicle:
+                  contact_options=None, name="vehicle", parking=False, accept=()) -> Vehicle:
     """A core model of the vehicle on ``track`` with its car body at arc length ``s0``.
 
     Parameters
@@ -394,16 +604,31 @@ def build_vehicle(definition: VehicleDefinition, track, s0: float, speed: float 
     parking : bool
         Add springs to the ground that fix the neutral directions of a vehicle at rest (its
         travel and the wheelset spins) for the static preload.
+    accept : sequence of str
+        Quantities of ``data/railway/plausible_ranges.csv`` whose plausible range is not enforced
+        (a deliberate outlier, e.g. ``accept=["speed"]``).
+
+    The suspension is unloaded in the straight design geometry of the vehicle: where the track
+    under it is not straight the model is built on the tangent at ``s0`` and its initial state
+    placed on the track (each body at its own arc length); start runs there from
+    :meth:`Vehicle.initial_state` (the quasi-static curving state).
+
+    The arguments are checked first (:func:`_check_build_arguments`): ``s0``, ``speed``,
+    ``lateral`` and ``speed_control`` may be given with a unit (``speed="72 km/h"``, a bare
+    number is SI); a speed, friction coefficient or lateral offset outside its plausible range,
+    an unknown creep law or contact option, and a vehicle that does not fit on an open track
+    are refused with one line naming the argument.
     """
     from core.model import ModelBuilder
 
     from .traction import TrackSpeedControl
     from .wheel_rail import WheelRailContact
 
+    s0, speed, mu, lateral, wheelset_lateral, speed_control, control_gain = _check_build_arguments(
+        definition, track, s0, speed, creep_law, creep_params, mu, lateral, wheelset_lateral, speed_control,
+        control_gain, contact_options, accept)
     D = definition
     g = D.geometry
-    if not np.isfinite(s0):
-        raise InputError(f"build_vehicle: s0 = {s0!r} m is not finite")
     b = ModelBuilder(3, name, gravity=(0.0, 0.0, -GRAVITY))
     dz1, dz2 = D.static_deflections() if unloaded else (0.0, 0.0)
     r0 = D.r0
@@ -413,12 +638,32 @@ def build_vehicle(definition: VehicleDefinition, track, s0: float, speed: float 
         raise InputError(f"build_vehicle: wheelset_lateral must have 4 values, got {wheelset_lateral!r}")
     s_b = [s0 + L_b, s0 - L_b]
     s_w = [s_b[0] + a_w, s_b[0] - a_w, s_b[1] + a_w, s_b[1] - a_w]
-    if min(s_w) < 0 or max(s_w) > track.length:
-        raise InputError(f"build_vehicle: the vehicle at s0 = {s0:g} m reaches from {min(s_w):g} to "
-                         f"{max(s_w):g} m, outside the track [0, {track.length:g}] m")
+    if not getattr(track, "closed", False) and (min(s_w) < 0 or max(s_w) > track.length):
+        ext = L_b + a_w
+        end = "before the start" if min(s_w) < 0 else "beyond the end"
+        at = min(s_w) if min(s_w) < 0 else max(s_w)
+        which = "rear" if min(s_w) < 0 else "leading"
+        lo, hi = ext, track.length - ext
+        fit = (f"place the car body at {lo:g} m <= s0 <= {hi:g} m" if lo <= hi else
+               f"the track ({track.length:g} m) is shorter than the vehicle's wheelbase ({2 * ext:g} m)")
+        raise InputError(f"build_vehicle: the {which} wheelset at s = {at:g} m lies {end} of the track "
+                         f"[0, {track.length:g}] m (car body at s0 = {s0:g} m): {fit}")
+
+    # the suspension is unloaded in the vehicle's design geometry, its bodies in a straight line:
+    # on a curve or transition the model is built on the tangent at s0 and then placed on the
+    # track (railway.curving_start, "Reference geometry"); on straight track the two coincide
+    straight = _straight_track(track, min(s_w), max(s_w))
+    on_track = {}
+
+    def place(s, y, z):
+        if straight:
+            return _placement(track, s, y, z)
+        pos, R = _placement(track, s0, 0.0, 0.0)
+        return pos + R @ np.array([s - s0, y, z]), R
 
     def add(nm, body, s, y, z, omega_axle=0.0):
-        pos, R = _placement(track, s, y, z)
+        on_track[nm] = (_placement(track, s, y, z), omega_axle)
+        pos, R = place(s, y, z)
         t = R[:, 0]
         b.add_body(nm, mass=body["mass"], inertia=body["inertia"], position=pos,
                    orientation=frames.matrix_to_euler(R), velocity=speed * t,
@@ -433,7 +678,7 @@ def build_vehicle(definition: VehicleDefinition, track, s0: float, speed: float 
     wheelsets = [f"wheelset {k + 1}" for k in range(4)]
     for k, nm in enumerate(wheelsets):
         add(nm, D.wheelset, s_w[k], lateral + wl[k], r0, omega_axle=speed / r0)
-    bs0 = {n: _placement(track, s, lateral, 0.0) for n, s in
+    bs0 = {n: place(s, lateral, 0.0) for n, s in
            zip([cb] + bogies + wheelsets, [s0] + s_b + s_w)}
 
     def point(body, s, x, y, z):
@@ -499,6 +744,8 @@ def build_vehicle(definition: VehicleDefinition, track, s0: float, speed: float 
         gain = D.total_mass / 0.5 if control_gain is None else float(control_gain)
         b.add_force(TrackSpeedControl("speed control", cb, track, speed_control, gain))
     model = b.build()
+    if not straight:
+        model = _place_on_track(model, on_track, speed)
     return Vehicle(definition=D, model=model, track=track, car_body=cb, bogies=bogies, wheelsets=wheelsets,
                    contact=contact, s0=float(s0), speed=float(speed), creep_law=creep_law,
                    _contact_options=contact_options)

@@ -7,6 +7,14 @@ command means writing one such function and appending it to the list.
 Units at this edge: lengths in mm and angles in degrees on the command line and in the
 Markdown summary; the CSV tables keep SI units (column names carry the unit).
 
+Every option is checked before anything is computed (issue 21): against its plausible range in
+``data/railway/plausible_ranges.csv``, in the unit its name carries (:mod:`railway.cli_checks`;
+``--accept QUANTITY`` lets a deliberate outlier through), profile files for existence and text,
+the wheelset for fitting the track, the lateral step for the smallest conicity amplitude
+(:data:`POINTS_PER_AMPLITUDE`) and the largest shift for the flangeway clearance plus the flange
+climb.  Bad input raises a :class:`core.errors.MbsuiteError` whose one-line message
+:func:`core.cli.main` prints.
+
 Example::
 
     mbsuite railway contact-table --gauge-mm 1435 --inclination 1:40 --flange-back-mm 1360 \\
@@ -15,17 +23,34 @@ Example::
 
 from __future__ import annotations
 
-import argparse
+import math
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from core.errors import InputError
 
+from .cli_checks import add_accept_option, check_file_option, option
 from .cli_creep import add_creep_curve_parser
+from .ranges import RailwayInputWarning
 
-__all__ = ["register", "run_contact_table"]
+__all__ = ["register", "run_contact_table", "ConicityResolutionWarning", "POINTS_PER_AMPLITUDE"]
+
+#: Lateral steps per conicity amplitude at least: the step of the table must not exceed
+#: A / POINTS_PER_AMPLITUDE for the smallest amplitude A.  On S1002 / UIC60 1:40 the equivalent
+#: conicity at 1-4 mm is within 2 % of the 0.05 mm-step value with 2 steps per amplitude and
+#: within 0.3 % with 4 (the error comes from locating the contact jumps between rows); 5 leaves a
+#: margin for worn profiles with more jumps.
+POINTS_PER_AMPLITUDE = 5
+
+
+class ConicityResolutionWarning(RailwayInputWarning):
+    """The lateral step of a contact table is too coarse for an equivalent-conicity amplitude:
+    that conicity is not computed (NaN); the message names --n and the value needed."""
+
+
 
 
 def _write_table(df, out_dir, stem):
@@ -65,20 +90,28 @@ def _add_contact_table(sub):
                    help="side of the field in the rail file's lateral coordinate (default positive)")
     p.add_argument("--rail-vertical", choices=("height", "depth"), default="height",
                    help="vertical column of the rail file: height (up, default) or depth (down)")
-    p.add_argument("--gauge-mm", type=float, default=1435.0, help="track gauge (14 mm below top)")
+    p.add_argument("--gauge-mm", type=float, default=1435.0,
+                   help="track gauge (14 mm below top; 600 ... 1700 mm)")
     p.add_argument("--inclination", default="1:40", help="rail inclination: 1:40, 1:20, vertical")
-    p.add_argument("--flange-back-mm", type=float, default=1360.0, help="flange-back spacing")
-    p.add_argument("--r0-mm", type=float, default=460.0, help="nominal rolling radius")
-    p.add_argument("--y-max-mm", type=float, default=10.0, help="largest lateral shift")
-    p.add_argument("--n", type=int, default=401, help="number of lateral shifts")
-    p.add_argument("--yaw-mrad", type=float, default=0.0, help="wheelset yaw angle")
-    p.add_argument("--amplitudes-mm", default="2,3,4",
-                   help="comma-separated amplitudes for the equivalent conicity")
+    p.add_argument("--flange-back-mm", type=float, default=1360.0,
+                   help="flange-back spacing (500 ... 1650 mm; the wheelset must fit the track)")
+    p.add_argument("--r0-mm", type=float, default=460.0, help="nominal rolling radius (150 ... 800 mm)")
+    p.add_argument("--y-max-mm", type=float, default=10.0,
+                   help="largest lateral shift (0.5 ... 50 mm, and at most the flangeway clearance "
+                        "plus the flange climb)")
+    p.add_argument("--n", type=int, default=401,
+                   help=f"number of lateral shifts (5 ... 10001; a step of at most 1/{POINTS_PER_AMPLITUDE} "
+                        "of the smallest amplitude for the conicity)")
+    p.add_argument("--yaw-mrad", type=float, default=0.0, help="wheelset yaw angle (-50 ... 50 mrad)")
+    p.add_argument("--amplitudes-mm", default=None,
+                   help="comma-separated amplitudes for the equivalent conicity (0.1 ... 20 mm, "
+                        "default 2,3,4)")
     p.add_argument("--load-kN", type=float, default=None,
                    help="also solve the quasi-static elastic contact under this vertical load per "
                         "wheel (Hertz normal forces balance the load) and report normal and "
-                        "lateral forces per contact")
+                        "lateral forces per contact (0.5 ... 500 kN)")
     p.add_argument("-o", "--out", default=None, help="output folder (default: print only)")
+    add_accept_option(p)
     p.set_defaults(func=run_contact_table)
     return p
 
@@ -96,9 +129,13 @@ def _load_wheel(args, r0):
             raise InputError(f"{', '.join(given)}: only for a wheel profile file, not the "
                              "built-in S1002")
         return WheelProfile.s1002(r0=r0)
+    check_file_option("--wheel", spec, builtin=["S1002"])
     back = args.wheel_back_mm
     if back is None:
         back = -70.0 if args.wheel_flange_side == "negative" else 70.0
+    elif not math.isfinite(back):
+        raise InputError(f"--wheel-back-mm {back!r}: not a finite number (mm in the wheel file's "
+                         "lateral coordinate, e.g. -70)")
     return WheelProfile.from_file(spec, r0=r0, y_back=back, flange_side=args.wheel_flange_side,
                                   vertical=args.wheel_vertical)
 
@@ -114,31 +151,164 @@ def _load_rail(args):
         if given:
             raise InputError(f"{', '.join(given)}: only for a rail profile file, not the built-in UIC60")
         return RailProfile.uic60()
+    check_file_option("--rail", spec, builtin=["UIC60"])
     return RailProfile.from_file(spec, field_side=args.rail_field_side, vertical=args.rail_vertical)
 
 
-#: Plausible ranges of the millimetre options (a value outside is taken for a unit slip).
-_MM_RANGES = {
-    "--r0-mm": ("r0_mm", 50.0, 2000.0, "nominal rolling radius", "460 for a 920 mm wheel"),
-    "--gauge-mm": ("gauge_mm", 300.0, 2000.0, "track gauge", "1435 for standard gauge"),
-    "--flange-back-mm": ("flange_back_mm", 250.0, 2000.0, "flange-back spacing",
-                         "1360 for standard gauge"),
-}
+def _check_contact_table_options(args):
+    """Every option of contact-table against its plausible range (one line naming the option,
+    the value and the likely unit slip); returns the values in SI as a dict."""
+    from .track import parse_inclination
+
+    acc = args.accept or ()
+    from core.inputs import ImplausibleValueError
+
+    v = {"n": int(option("contact_table_points", args.n, "--n", accept=acc)), "y_max_error": None}
+    try:
+        v["y_max"] = option("contact_table_lateral_shift", args.y_max_mm, "--y-max-mm", "mm", acc)
+    except ImplausibleValueError as exc:
+        if not (exc.value > 0 and not exc.suggestion):
+            raise
+        # too large, and not a unit slip: the flangeway clearance names the limit (_check_fit)
+        v["y_max"], v["y_max_error"] = exc.value, exc
+    v.update({
+        "gauge": option("gauge", args.gauge_mm, "--gauge-mm", "mm", acc),
+        "flange_back": option("flange_back_spacing", args.flange_back_mm, "--flange-back-mm", "mm", acc),
+        "r0": option("nominal_wheel_radius", args.r0_mm, "--r0-mm", "mm", acc),
+        "yaw": option("wheelset_yaw_angle", args.yaw_mrad, "--yaw-mrad", "mrad", acc),
+    })
+    try:
+        v["inclination"] = parse_inclination(args.inclination)
+    except InputError as exc:
+        raise InputError(f"--inclination {args.inclination}: {exc}") from None
+    option("rail_inclination", v["inclination"], "--inclination", accept=acc)
+    if args.load_kN is not None:
+        v["load"] = option("wheel_normal_load", args.load_kN, "--load-kN", "kN", acc)
+    if v["flange_back"] >= v["gauge"]:
+        raise InputError(f"--flange-back-mm {args.flange_back_mm:g} is not below --gauge-mm "
+                         f"{args.gauge_mm:g}: the flanges run inside the rails (standard gauge: 1435 "
+                         "and 1360)")
+    explicit = args.amplitudes_mm is not None
+    text = args.amplitudes_mm if explicit else "2,3,4"
+    try:
+        amps_mm = [float(a) for a in text.split(",") if a.strip()]
+    except ValueError:
+        raise InputError(f"--amplitudes-mm {text!r}: expected numbers in mm separated by commas, "
+                         "e.g. 2,3,4") from None
+    if not amps_mm:
+        raise InputError(f"--amplitudes-mm {text!r}: give at least one amplitude, e.g. 2,3,4")
+    amps = [option("conicity_amplitude", a, "--amplitudes-mm", "mm", acc) for a in amps_mm]
+    too_big = [a for a, si in zip(amps_mm, amps) if si > v["y_max"] and v["y_max_error"] is None]
+    if too_big and explicit:
+        raise InputError(f"--amplitudes-mm {text}: the amplitude {too_big[0]:g} mm exceeds --y-max-mm "
+                         f"{args.y_max_mm:g} (the table must cover the amplitude; give --y-max-mm "
+                         f">= {max(amps_mm):g})")
+    v["amplitudes"] = np.array(sorted(set(amps)))
+    v["amplitudes_explicit"] = explicit
+    return v
 
 
-def _check_mm_options(args):
-    """InputError naming the option, its value and the unit for a value outside its plausible
-    range (e.g. --gauge-mm 1.435: metres given where millimetres are expected)."""
-    for opt, (attr, lo, hi, what, example) in _MM_RANGES.items():
-        v = getattr(args, attr)
-        if not np.isfinite(v) or not (lo <= v <= hi):
-            hint = " (it looks like metres)" if np.isfinite(v) and 0 < v < lo / 100.0 else ""
-            raise InputError(f"{opt} {v!r}: the {what} is given in millimetres and must lie in "
-                             f"[{lo:g}, {hi:g}] mm{hint}; e.g. {example}")
+def _flange_geometry(wheel):
+    """Flange thickness Sd (m; at 10 mm above the tread datum, 70 mm from the back face, EN 15313),
+    flange height (m; tip above the datum), the largest flange angle (rad) and the flange climb
+    (m): the lateral travel from flange contact until the tip reaches the rail top, height/tan(angle)."""
+    datum = wheel.y_back + 0.070 if wheel.y_back < wheel.y_tip else wheel.y_back - 0.070
+    ys = np.linspace(wheel.y_tip, datum, 4001)  # from the tip to the datum
+    F, dF, _ = wheel.evaluate(ys)
+    F0 = float(wheel.evaluate(np.array([datum]))[0][0])
+    height = float(F[0] - F0)
+    above = np.nonzero(F - F0 >= 0.010)[0]
+    sd = float(abs(ys[above[-1]] - wheel.y_back)) if above.size else math.nan
+    angle = float(np.max(np.arctan(np.abs(dF))))
+    climb = height / math.tan(angle) if angle > 0 else math.inf
+    return sd, height, angle, climb
+
+
+def _check_fit(wheel, rail, v, args):
+    """The centred wheelset must stand on both rails with its flanges clear of them."""
+    from .contact_geometry import contact_geometry_table
+
+    sd, _, _, _ = _flange_geometry(wheel)
+    play = (v["gauge"] - v["flange_back"] - 2.0 * sd) / 2.0 if math.isfinite(sd) else math.nan
+    detail = (f"gauge {args.gauge_mm:g} mm - flange-back {args.flange_back_mm:g} mm - 2 x flange "
+              f"thickness {sd * 1e3:.1f} mm leaves {play * 1e3:.1f} mm each side"
+              if math.isfinite(play) else f"gauge {args.gauge_mm:g} mm, flange-back {args.flange_back_mm:g} mm")
+    typical = f"{(v['gauge'] - 2 * sd - 0.010) * 1e3:.0f}" if math.isfinite(sd) else "gauge - 75"
+    from core.errors import RUN_FAILURES
+
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            row = contact_geometry_table(np.array([0.0]), yaw=v["yaw"], wheel=wheel, rail=rail,
+                                         gauge=v["gauge"], inclination=v["inclination"],
+                                         flange_back_spacing=v["flange_back"]).iloc[0]
+    except RUN_FAILURES as exc:
+        # the centred wheelset on nominal track: a failure here comes from the profiles
+        raise InputError(f"--wheel {args.wheel}, --rail {args.rail}: the centred wheelset cannot be placed "
+                         f"on the rails ({type(exc).__name__}: {exc}); check that the rail file is a rail "
+                         "head (a convex crown, heights up) and the wheel file a wheel (flange, tread)") from None
+    if row["status"] != "ok" or bool(row["flange_L"]) or bool(row["flange_R"]):
+        raise InputError(f"--flange-back-mm {args.flange_back_mm:g}: the wheelset does not fit the track: "
+                         f"centred, its flanges touch the rails ({detail}); for this wheel and gauge "
+                         f"the flange-back spacing is about {typical} mm")
+    if math.isfinite(play) and play > 0.030 and "flange_back_spacing" not in (args.accept or ()):
+        raise InputError(f"--flange-back-mm {args.flange_back_mm:g}: the wheelset has {play * 1e3:.0f} mm of "
+                         f"play each side ({detail}; track and wheel limits allow some 5-30 mm); for this "
+                         f"wheel and gauge the flange-back spacing is about {typical} mm "
+                         "(to use it deliberately: --accept flange_back_spacing)")
+    # the largest shift: at most the flangeway clearance (flange contact onset, from a table of
+    # 0.25 mm steps located by bisection) plus the flange climb, beyond which the wheelset derails
+    from .contact_geometry import flange_contact_onset
+
+    _, height, angle, climb = _flange_geometry(wheel)
+    play_ = play if math.isfinite(play) else 0.01
+    # the estimate play_ is within about 1-2 mm of the onset (gauge and flange thickness are
+    # measured at different heights): locate the onset exactly only when the limit is near
+    if v["y_max"] > play_ + climb - 0.005 or v["y_max_error"] is not None:
+        ys = np.arange(0.0, max(play_, 0.0) + 0.005 + 1e-9, 2.5e-4)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            t = contact_geometry_table(ys, yaw=v["yaw"], wheel=wheel, rail=rail, gauge=v["gauge"],
+                                       inclination=v["inclination"], flange_back_spacing=v["flange_back"])
+        try:
+            y_f, _ = flange_contact_onset(t, wheel=wheel, rail=rail)
+        except RuntimeError:
+            y_f, _ = flange_contact_onset(t, wheel=wheel, rail=rail, exact=False)
+        if np.isfinite(y_f) and v["y_max"] > y_f + climb:
+            raise InputError(
+                f"--y-max-mm {args.y_max_mm:g}: beyond the flangeway clearance {y_f * 1e3:.2f} mm (flange "
+                f"contact from there) plus the flange climb {climb * 1e3:.1f} mm (flange height "
+                f"{height * 1e3:.1f} mm at {math.degrees(angle):.0f} deg) the wheelset has derailed; give "
+                f"--y-max-mm <= {math.floor((y_f + climb) * 1e3):g}, e.g. 10")
+    if v["y_max_error"] is not None:
+        raise v["y_max_error"]
+
+
+def _regime(df, wheel):
+    """Per row: "tread", "flange" (flange contact on the flank or the root) or "flange climb"
+    (the contact has passed the top of the flank: the wheel is climbing its flange); other
+    statuses are kept."""
+    top = wheel.y_flank_top
+    out = np.where(df["status"] == "ok", "tread", df["status"].astype(str))
+    fl = (df["status"] == "ok") & (df["flange_L"].astype(bool) | df["flange_R"].astype(bool))
+    out = np.where(fl, "flange", out)
+    climb = (df["status"] == "ok") & (
+        (df["flange_L"].astype(bool) & (df["y_wheel_L [m]"] < top))
+        | (df["flange_R"].astype(bool) & (df["y_wheel_R [m]"] < top)))
+    return np.where(climb, "flange climb", out)
 
 
 def run_contact_table(args) -> int:
-    """Compute the table, print a summary, and write CSV/Markdown/PNG when ``--out`` is given."""
+    """Compute the table, print a summary, and write CSV/Markdown/PNG when ``--out`` is given.
+
+    Every option is checked first (plausible ranges of ``data/railway/plausible_ranges.csv`` in
+    the option's unit, the profile files, the wheelset fitting the track); then the table's
+    lateral step against the smallest conicity amplitude (:data:`POINTS_PER_AMPLITUDE`; a
+    conicity it cannot resolve is NaN with a :class:`ConicityResolutionWarning`), and the largest
+    shift against the flangeway clearance plus the flange climb (refused beyond: the wheelset
+    would have derailed).  Rows with the wheel climbing its flange are marked in the column
+    ``regime`` and counted in the summary.
+    """
     from .contact_geometry import (
         conicity_table,
         contact_geometry_table,
@@ -146,31 +316,45 @@ def run_contact_table(args) -> int:
         flange_contact_onset,
     )
 
-    if args.n < 5:
-        raise InputError(f"--n {args.n}: at least 5 lateral shifts are needed")
-    if not (args.y_max_mm > 0):
-        raise InputError(f"--y-max-mm {args.y_max_mm!r} must be positive")
-    _check_mm_options(args)
+    v = _check_contact_table_options(args)
     if args.out:  # a path that is a file is refused before the computation, not after it
         from core.paths import output_folder
 
         output_folder(args.out)
-    try:
-        amps = np.array([float(a) for a in args.amplitudes_mm.split(",")]) * 1e-3
-    except ValueError:
-        raise InputError(f"--amplitudes-mm {args.amplitudes_mm!r}: expected e.g. 2,3,4") from None
-    load = getattr(args, "load_kN", None)
-    if load is not None and not (np.isfinite(load) and load > 0):
-        raise InputError(f"--load-kN {load!r}: the vertical wheel load must be positive")
-    wheel = _load_wheel(args, args.r0_mm * 1e-3)
+    amps = v["amplitudes"]
+    load = args.load_kN
+    wheel = _load_wheel(args, v["r0"])
     rail = _load_rail(args)
-    y = np.linspace(-args.y_max_mm, args.y_max_mm, args.n) * 1e-3
-    df = contact_geometry_table(y, yaw=args.yaw_mrad * 1e-3, wheel=wheel, rail=rail,
-                                gauge=args.gauge_mm * 1e-3, inclination=args.inclination,
-                                flange_back_spacing=args.flange_back_mm * 1e-3)
-    con = conicity_table(df, amps[amps <= args.y_max_mm * 1e-3])
+    _check_fit(wheel, rail, v, args)
+    n, y_max = v["n"], v["y_max"]
+    step = 2.0 * y_max / (n - 1)
+    resolved = amps >= POINTS_PER_AMPLITUDE * step * (1 - 1e-12)
+    coarse = ~resolved & (amps <= y_max)  # (a default amplitude beyond y_max: noted in the summary)
+    if np.any(coarse):
+        a_min = float(amps[coarse].min())
+        need = math.ceil(2.0 * y_max * POINTS_PER_AMPLITUDE / a_min * (1 - 1e-12)) + 1
+        warnings.warn(ConicityResolutionWarning(
+            f"--n {n}: the lateral step {step * 1e3:.3g} mm is too coarse for the conicity at "
+            + ", ".join(f"{a * 1e3:g}" for a in amps[coarse])
+            + f" mm (at least {POINTS_PER_AMPLITUDE} steps per amplitude); not computed: give --n >= "
+            f"{need} for --y-max-mm {args.y_max_mm:g}"), stacklevel=2)
+    y = np.linspace(-y_max, y_max, n)
+    geo = dict(yaw=v["yaw"], wheel=wheel, rail=rail, gauge=v["gauge"], inclination=v["inclination"],
+               flange_back_spacing=v["flange_back"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # rows out of reach: reported by status
+        df = contact_geometry_table(y, **geo)
     trans = contact_transitions(df, wheel=wheel, rail=rail)
-    y_f, g_f = flange_contact_onset(df, wheel=wheel, rail=rail, transitions=trans)
+    onset_note = ""
+    try:
+        y_f, g_f = flange_contact_onset(df, wheel=wheel, rail=rail, transitions=trans)
+    except RuntimeError as exc:  # the bisection between two rows failed: report the row
+        y_f, g_f = flange_contact_onset(df, wheel=wheel, rail=rail, exact=False)
+        onset_note = f" (at the first table row: {exc})"
+    angle = _flange_geometry(wheel)[2]
+    df["regime"] = _regime(df, wheel)
+    con = conicity_table(df, amps[(amps <= y_max) & resolved])
+    con = con.set_index("amplitude [m]").reindex(amps).rename_axis("amplitude [m]").reset_index()
     summary = [
         (f"wheel {wheel.name}, rail {rail.name}, gauge {args.gauge_mm:g} mm, inclination "
          f"{args.inclination}, flange-back {args.flange_back_mm:g} mm, r0 {args.r0_mm:g} mm"),
@@ -180,9 +364,18 @@ def run_contact_table(args) -> int:
         summary.append(f"{len(bad)} of {len(df)} lateral shifts have no rigid contact and are left "
                        f"out of every figure below (from {bad['y [m]'].min() * 1e3:.3f} to "
                        f"{bad['y [m]'].max() * 1e3:.3f} mm; first: {bad['status'].iloc[0]})")
-    if np.isfinite(y_f):
+    if np.isfinite(y_f) and onset_note:
+        summary.append(f"flange contact from lateral shift {y_f * 1e3:.4f} mm{onset_note}")
+    elif np.isfinite(y_f):
         summary.append(f"flange contact from lateral shift {y_f * 1e3:.4f} mm (located by "
                        f"bisection to 0.1 um), contact angle {np.degrees(g_f):.2f} deg")
+    climbing = df[df["regime"] == "flange climb"]
+    if len(climbing):
+        ay = climbing["y [m]"].abs() * 1e3
+        text = (f"{len(climbing)} of {len(df)} lateral shifts (|y| from {ay.min():.3f} mm) have a wheel "
+                f"past the top of its flange flank ({math.degrees(angle):.0f} deg): climbing its "
+                "flange, not a position a running wheelset holds (column regime = 'flange climb')")
+        summary.append(text)
     else:
         summary.append("no flange contact on the left wheel in the table's range")
     if "lead_L [m]" in df.columns and np.isfinite(y_f):
@@ -197,6 +390,16 @@ def run_contact_table(args) -> int:
         summary.append("contact jumps of the left wheel at lateral shifts "
                        + ", ".join(f"{v * 1e3:.4f}" for v in jumps["y [m]"]) + " mm")
     for _, row in con.iterrows():
+        a = row["amplitude [m]"]
+        if a > y_max:
+            summary.append(f"equivalent conicity at {a * 1e3:g} mm: not computed (beyond --y-max-mm "
+                           f"{args.y_max_mm:g})")
+            continue
+        if a < POINTS_PER_AMPLITUDE * step * (1 - 1e-12):
+            summary.append(f"equivalent conicity at {a * 1e3:g} mm: not computed (lateral step "
+                           f"{step * 1e3:.3g} mm; give --n >= "
+                           f"{math.ceil(2 * y_max * POINTS_PER_AMPLITUDE / a * (1 - 1e-12)) + 1})")
+            continue
         summary.append(
             f"equivalent conicity at {row['amplitude [m]'] * 1e3:g} mm: "
             f"{row['conicity wavelength [-]']:.4f} (wavelength), "
@@ -205,9 +408,7 @@ def run_contact_table(args) -> int:
     if load is not None:
         from .quasi_static import quasi_static_contact, quasi_static_summary
 
-        qs = quasi_static_contact(y, load * 1e3, yaw=args.yaw_mrad * 1e-3, wheel=wheel, rail=rail,
-                                  gauge=args.gauge_mm * 1e-3, inclination=args.inclination,
-                                  flange_back_spacing=args.flange_back_mm * 1e-3)
+        qs = quasi_static_contact(y, v["load"], **geo)
         sm = quasi_static_summary(qs)
         head = f"quasi-static contact under {load:g} kN per wheel"
         if sm["converged shifts"] == 0:
@@ -290,12 +491,11 @@ def register(subparsers):
 
 
 def main(argv=None) -> int:
-    """Stand-alone entry: ``python -m railway.cli contact-table ...``."""
-    parser = argparse.ArgumentParser(prog="mbsuite-railway")
-    sub = parser.add_subparsers(dest="cmd")
-    register(sub)
-    args = parser.parse_args(["railway"] + list(sys.argv[1:] if argv is None else argv))
-    return args.func(args)
+    """Stand-alone entry: ``python -m railway.cli contact-table ...`` (the same as ``mbsuite
+    railway contact-table ...``: one-line errors, exit 2 on bad input)."""
+    from core.cli import main as core_main
+
+    return core_main(["railway"] + list(sys.argv[1:] if argv is None else argv))
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -42,7 +42,7 @@ def semi_axes_from_curvatures(normal_force, A, B, E, nu):
 
 def creep_curve(models="polach2000", creepage: str = "xi", values=None, *, normal_force,
                 a=None, b=None, A=None, B=None, E=None, G=None, nu=0.28, mu=0.3,
-                xi=0.0, eta=0.0, phi=0.0, model_params=None) -> pd.DataFrame:
+                xi=0.0, eta=0.0, phi=0.0, model_params=None, accept=()) -> pd.DataFrame:
     """Creep forces along a sweep of one creepage, for one or several creep models.
 
     Parameters
@@ -69,6 +69,16 @@ def creep_curve(models="polach2000", creepage: str = "xi", values=None, *, norma
         The creepages held fixed (the swept one is ignored).
     model_params : dict, optional
         ``{model_name: {param: value}}`` constructor parameters.
+    accept : iterable of str
+        Quantities of ``data/railway/plausible_ranges.csv`` whose range is not enforced
+        (``wheel_normal_load``, ``friction_coefficient``, ``poisson_ratio``, ``youngs_modulus``,
+        ``shear_modulus``, ``creepage``, ``spin_creepage``): a deliberate outlier.
+
+    Raises
+    ------
+    core.inputs.ImplausibleValueError
+        A value outside its plausible range (the likely unit slip named), e.g. ``mu = 30`` (per
+        cent) or ``E = 210`` (GPa given as Pa).
 
     Returns
     -------
@@ -87,6 +97,20 @@ def creep_curve(models="polach2000", creepage: str = "xi", values=None, *, norma
         raise InputError(f"creep curve: normal_force = {normal_force!r} N must be positive (the "
                          "curve is normalised by mu N; a creep curve of an unloaded contact is "
                          "zero)")
+    from .ranges import ranges
+
+    R = ranges()
+    R.check("wheel_normal_load", N, where="creep curve: normal_force", accept=accept)
+    R.check("friction_coefficient", mu, where="creep curve: mu", accept=accept)
+    R.check("poisson_ratio", nu, where="creep curve: nu", accept=accept)
+    for key, val in (("E", E), ("G", G)):
+        if val is not None:
+            R.check("youngs_modulus" if key == "E" else "shear_modulus", val, where=f"creep curve: {key}",
+                    accept=accept)
+    for key, val in (("xi", xi), ("eta", eta), ("phi", phi)):
+        if key != creepage:
+            R.check("spin_creepage" if key == "phi" else "creepage", val, where=f"creep curve: {key}",
+                    accept=accept)
     if a is None or b is None:
         if A is None or B is None or E is None:
             raise ValueError("give the semi-axes a, b or the curvatures A, B with E")
@@ -110,6 +134,9 @@ def creep_curve(models="polach2000", creepage: str = "xi", values=None, *, norma
     values = np.asarray(values, dtype=float)
     if values.ndim != 1 or values.size == 0:
         raise ValueError(f"values must be a non-empty 1-D array, got shape {values.shape}")
+    if values.size:
+        R.check("spin_creepage" if creepage == "phi" else "creepage", [values.min(), values.max()],
+                where=f"creep curve: swept {creepage} (smallest, largest)", accept=accept)
     if isinstance(models, (str, bytes)) or not np.iterable(models):
         models = [models]
     model_params = model_params or {}

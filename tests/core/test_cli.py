@@ -317,3 +317,156 @@ def test_atomic_write_keeps_the_old_file_when_writing_fails(tmp_path):
         write_atomically(target, failing)
     assert target.read_text() == "old, complete\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]
+
+
+# ---------------------------------------------------------------------------------------------
+# issue 21: no traceback on bad input, from any registered sub-command
+# ---------------------------------------------------------------------------------------------
+def _leaf_commands(parser, path=()):
+    """(path, sub-parser) of every runnable sub-command (plug-ins included)."""
+    import argparse
+
+    subs = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    if not subs:
+        yield path, parser
+        return
+    for name, sub in subs[0].choices.items():
+        yield from _leaf_commands(sub, path + (name,))
+
+
+def _sweep_cases():
+    import argparse
+
+    cases = []
+    for path, sub in _leaf_commands(cli.build_parser()):
+        cases.append((list(path) + ["--no-such-option"], "unknown option"))
+        for action in sub._actions:
+            if not action.option_strings or action.nargs == 0 or isinstance(action, argparse._HelpAction):
+                continue
+            opt = max(action.option_strings, key=len)
+            if action.choices is not None:
+                first = str(list(action.choices)[0])
+                cases.append((list(path) + [opt, first[:-1] + "x"], "misspelt choice"))
+            elif action.type is not None:  # numbers and checked names
+                for bad in ("nan", "-1e30", "abc"):
+                    cases.append((list(path) + [opt, bad], f"bad value {bad}"))
+    return cases
+
+
+_SWEEP = _sweep_cases()
+
+
+@pytest.mark.parametrize("argv,what", _SWEEP, ids=[" ".join(a) for a, _ in _SWEEP])
+def test_every_subcommand_refuses_bad_options_without_traceback(argv, what, capsys, tmp_path, monkeypatch):
+    """Every registered sub-command (plug-ins included), every typed option: a bad value is one line
+    ``mbsuite: error: ...`` naming the option, exit 2, never a traceback."""
+    monkeypatch.chdir(tmp_path)  # nothing is written into the checkout
+    code = cli.main(argv)
+    err = capsys.readouterr().err
+    assert "Traceback" not in err, err
+    assert code == 2, (argv, err)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("mbsuite: error: "), err
+    opt = argv[-2] if what != "unknown option" else argv[-1]
+    assert opt in lines[0] or opt.lstrip("-") in lines[0], lines[0]
+
+
+def test_sweep_covers_every_command():
+    leaves = {path for path, _ in _leaf_commands(cli.build_parser())}
+    assert {("list",), ("run",), ("bench",), ("railway", "contact-table"), ("railway", "creep-curve")} <= leaves
+    assert len(_SWEEP) >= 60
+
+
+def _run_with_command(func, argv=()):
+    """main() with a parser whose only command runs ``func``."""
+    parser = cli.Parser(prog="mbsuite")
+    parser.add_argument("--debug", "--traceback", dest="traceback", action="store_true")
+    sub = parser.add_subparsers(dest="command")
+    sub.add_parser("boom").set_defaults(func=func)
+    orig = cli.build_parser
+    cli.build_parser = lambda: parser
+    try:
+        return cli.main([*argv, "boom"])
+    finally:
+        cli.build_parser = orig
+
+
+def test_an_internal_error_is_one_line_naming_a_bug(capsys):
+    """A bug (not bad input) is reported as such: one line, exit 3, the traceback only with --debug."""
+    def boom(args):
+        return {}["no such key"]
+
+    assert _run_with_command(boom) == 3
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert err.startswith("mbsuite: internal error (a bug in mbsuite, please report it): KeyError: 'no such key' "
+                          "(in test_cli.py:")
+    assert err.strip().endswith("run again with --debug for the traceback")
+    with pytest.raises(KeyError):
+        _run_with_command(boom, ["--debug"])
+
+
+def test_bad_input_with_debug_shows_the_exception(capsys):
+    def bad(args):
+        raise InputError("--gauge-mm 1.435: deliberately bad")
+
+    assert _run_with_command(bad) == 2
+    assert capsys.readouterr().err == "mbsuite: error: --gauge-mm 1.435: deliberately bad\n"
+    with pytest.raises(InputError, match="deliberately bad"):
+        _run_with_command(bad, ["--debug"])
+
+
+def test_a_numerical_failure_is_exit_1(capsys):
+    from core.errors import NumericalFailure
+
+    def fails(args):
+        raise NumericalFailure("Newton did not converge at t = 0.25 s")
+
+    assert _run_with_command(fails) == 1
+    assert capsys.readouterr().err == ("mbsuite: error: numerical failure: Newton did not converge at t = 0.25 s "
+                                       "[NumericalFailure]\n")
+
+
+def test_a_warning_is_one_line_with_its_class(capsys):
+    import warnings
+
+    class DemoWarning(UserWarning):
+        pass
+
+    def warns(args):
+        warnings.warn(DemoWarning("the step is\ncoarse"))
+        return 0
+
+    assert _run_with_command(warns) == 0
+    assert capsys.readouterr().err == "mbsuite: warning: the step is coarse [DemoWarning]\n"
+
+
+def test_misspelt_names_suggest_the_closest(registry, capsys):
+    assert cli.main(["rn"]) == 2
+    assert "invalid choice: 'rn'; did you mean 'run'?" in capsys.readouterr().err
+    assert cli.main(["run", "ok-scen"]) == 2
+    assert "unknown scene(s): ok-scen; did you mean 'ok-scene'?" in capsys.readouterr().err
+
+
+def test_too_many_workers_is_refused(registry, capsys, tmp_path):
+    import os
+
+    n = 4 * (os.cpu_count() or 1) + 1
+    assert cli.main(["run", "ok-scene", "-o", str(tmp_path), "--workers", str(n)]) == 2
+    assert f"--workers {n}: this machine has" in capsys.readouterr().err
+
+
+def test_bench_and_run_options_are_checked_before_running(registry, capsys, tmp_path):
+    import os
+
+    blocker = tmp_path / "afile"
+    blocker.write_text("x")
+    for argv, expected in (
+        (["bench", "andrews", "-o", str(blocker)], "output folder '" + str(blocker) + "' cannot be created: it is a file"),
+        (["bench", "andrews", "-j", str(4 * (os.cpu_count() or 1) + 1)], "worker processes only slow the runs down"),
+        (["run", "ok-scene", "-o", str(tmp_path / "o"), "--dask", "localhost"],
+         "--dask 'localhost': give the scheduler's address with its port, e.g. tcp://host:8786"),
+    ):
+        assert cli.main(argv) == 2
+        err = capsys.readouterr().err
+        assert "Traceback" not in err and len(err.strip().splitlines()) == 1 and expected in err, err

@@ -418,7 +418,8 @@ def test_cli_creep_curve(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         bad.func(bad)
     assert exc.value.code == 2
-    assert "mu must be > 0, got -0.1" in capsys.readouterr().err
+    # issue 21: the option is checked against its plausible range before the model sees it
+    assert "--mu -0.1: the wheel-rail friction coefficient must lie in 0.01 ... 1" in capsys.readouterr().err
 
 
 def test_every_registered_creep_law_is_in_the_property_lists():

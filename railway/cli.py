@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from core.errors import InputError
+from core.errors import InputError, NumericalFailure
 
 from .cli_checks import add_accept_option, check_file_option, option
 from .cli_creep import add_creep_curve_parser
@@ -241,7 +241,8 @@ def _check_fit(wheel, rail, v, args):
             warnings.simplefilter("ignore", RuntimeWarning)
             row = contact_geometry_table(np.array([0.0]), yaw=v["yaw"], wheel=wheel, rail=rail,
                                          gauge=v["gauge"], inclination=v["inclination"],
-                                         flange_back_spacing=v["flange_back"]).iloc[0]
+                                         flange_back_spacing=v["flange_back"],
+                                         accept=args.accept or ()).iloc[0]
     except RUN_FAILURES as exc:
         # the centred wheelset on nominal track: a failure here comes from the profiles
         raise InputError(f"--wheel {args.wheel}, --rail {args.rail}: the centred wheelset cannot be placed "
@@ -269,10 +270,11 @@ def _check_fit(wheel, rail, v, args):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             t = contact_geometry_table(ys, yaw=v["yaw"], wheel=wheel, rail=rail, gauge=v["gauge"],
-                                       inclination=v["inclination"], flange_back_spacing=v["flange_back"])
+                                       inclination=v["inclination"], flange_back_spacing=v["flange_back"],
+                                       accept=args.accept or ())
         try:
             y_f, _ = flange_contact_onset(t, wheel=wheel, rail=rail)
-        except RuntimeError:
+        except NumericalFailure:  # the bisection stopped: the first table row is near enough here
             y_f, _ = flange_contact_onset(t, wheel=wheel, rail=rail, exact=False)
         if np.isfinite(y_f) and v["y_max"] > y_f + climb:
             raise InputError(
@@ -340,7 +342,7 @@ def run_contact_table(args) -> int:
             f"{need} for --y-max-mm {args.y_max_mm:g}"), stacklevel=2)
     y = np.linspace(-y_max, y_max, n)
     geo = dict(yaw=v["yaw"], wheel=wheel, rail=rail, gauge=v["gauge"], inclination=v["inclination"],
-               flange_back_spacing=v["flange_back"])
+               flange_back_spacing=v["flange_back"], accept=args.accept or ())
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # rows out of reach: reported by status
         df = contact_geometry_table(y, **geo)
@@ -348,7 +350,7 @@ def run_contact_table(args) -> int:
     onset_note = ""
     try:
         y_f, g_f = flange_contact_onset(df, wheel=wheel, rail=rail, transitions=trans)
-    except RuntimeError as exc:  # the bisection between two rows failed: report the row
+    except NumericalFailure as exc:  # the bisection between two rows failed: report the row
         y_f, g_f = flange_contact_onset(df, wheel=wheel, rail=rail, exact=False)
         onset_note = f" (at the first table row: {exc})"
     angle = _flange_geometry(wheel)[2]

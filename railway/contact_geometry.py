@@ -69,7 +69,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from core.errors import InputError
+from core.errors import InputError, NumericalFailure
 
 from .contact_search import FLANGE, ContactSearch, wheelset_pose
 from .profiles import WheelProfile
@@ -81,7 +81,7 @@ __all__ = ["rigid_contact", "contact_geometry_table", "equivalent_conicity", "co
 
 def rigid_contact(lateral, yaw=0.0, wheel=None, rail=None, gauge=1.435, inclination=1 / 40,
                   flange_back_spacing=1.360, tol=1e-10, max_iter=40, errors="raise", n_scan=64,
-                  n_seeds=4):
+                  n_seeds=4, accept=()):
     """Solve the rigid (zero-penetration) contact of a wheelset for many lateral shifts.
 
     Parameters
@@ -109,12 +109,14 @@ def rigid_contact(lateral, yaw=0.0, wheel=None, rail=None, gauge=1.435, inclinat
         Newton iterations on (z, roll).
     errors : {"raise", "mark"}
         What a shift without a solution does: raise (``"raise"``; an
-        :class:`core.errors.InputError` when the shift is out of reach, a ``RuntimeError``
-        when the search or the iteration failed) or only set its status (``"mark"``): its z,
+        :class:`core.errors.InputError` when the shift is out of reach, a
+        :class:`core.errors.NumericalFailure` when the search or the iteration failed) or only set its status (``"mark"``): its z,
         roll and contact outputs are then NaN and the other shifts are unaffected.
     n_scan, n_seeds : int
         Grid points per zone of the contact search's seed scan, and stationary points of the
         scan refined side by side (see :class:`railway.contact_search.ContactSearch`).
+    accept : sequence of str
+        ``["gauge"]`` for a gauge outside its plausible range (:class:`railway.track.RailMounting`).
 
     Returns
     -------
@@ -142,7 +144,7 @@ def rigid_contact(lateral, yaw=0.0, wheel=None, rail=None, gauge=1.435, inclinat
     if np.any(~np.isfinite(yaw)):
         raise InputError(f"yaw angle {yaw[~np.isfinite(yaw)][0]!r} is not finite")
     wheel = wheel if wheel is not None else WheelProfile.s1002()
-    mount = RailMounting(rail, gauge=gauge, inclination=inclination)
+    mount = RailMounting(rail, gauge=gauge, inclination=inclination, accept=accept)
     track = Track.straight(20.0)
     N = y.size
     cs = ContactSearch(track, wheel=wheel, rails=mount, n_wheelsets=N,
@@ -235,7 +237,8 @@ def rigid_contact(lateral, yaw=0.0, wheel=None, rail=None, gauge=1.435, inclinat
         k = int(np.argmax(failed))
         if status[k].startswith("out of reach"):
             raise InputError(f"rigid contact: {status[k]}")
-        raise RuntimeError(f"rigid contact: {status[k]}")
+        raise NumericalFailure(f"rigid contact of wheel {wheel.name} on rail {mount.profile.name}, gauge "
+                               f"{mount.gauge * 1e3:g} mm: {status[k]}")
     # lead: longitudinal position of each contact point ahead of its wheel centre (the centre
     # of the taping-line circle), measured along the track tangent; non-zero with a yaw angle
     sig = np.array([1.0, -1.0])
@@ -322,7 +325,8 @@ def _out_of_reach(wheel, mount, L, shift):
 
 
 def contact_geometry_table(lateral=None, yaw=0.0, wheel=None, rail=None, gauge=1.435,
-                           inclination=1 / 40, flange_back_spacing=1.360, flange_angle=np.pi / 4):
+                           inclination=1 / 40, flange_back_spacing=1.360, flange_angle=np.pi / 4,
+                           accept=()):
     """Rigid contact-geometry table of a wheelset against lateral shift.
 
     Parameters
@@ -334,6 +338,8 @@ def contact_geometry_table(lateral=None, yaw=0.0, wheel=None, rail=None, gauge=1
     flange_angle : float
         A contact whose contact angle exceeds this (rad, default 45 deg) is flagged as flange
         contact (flank or flange root), as is any contact found by the flange candidate.
+    accept : sequence of str
+        ``["gauge"]`` for a gauge outside its plausible range (kept in ``attrs``).
 
     Returns
     -------
@@ -356,7 +362,7 @@ def contact_geometry_table(lateral=None, yaw=0.0, wheel=None, rail=None, gauge=1
     y = np.atleast_1d(np.asarray(lateral, dtype=float))
     wheel = wheel if wheel is not None else WheelProfile.s1002()
     z, roll, res, active = rigid_contact(y, yaw, wheel, rail, gauge, inclination,
-                                         flange_back_spacing, errors="mark")
+                                         flange_back_spacing, errors="mark", accept=accept)
     status = res.extra["status"]
     ok = status == "ok"
     N = y.size
@@ -388,7 +394,7 @@ def contact_geometry_table(lateral=None, yaw=0.0, wheel=None, rail=None, gauge=1
     df = pd.DataFrame(cols)
     df.attrs.update(wheel=wheel.name, r0=wheel.r0, rail=(rail.name if rail is not None else "UIC60"),
                     gauge=gauge, inclination=inclination, flange_back_spacing=flange_back_spacing,
-                    flange_angle=flange_angle)
+                    flange_angle=flange_angle, accept=tuple([accept] if isinstance(accept, str) else accept))
     return df
 
 
@@ -457,7 +463,7 @@ def contact_transitions(table, wheel=None, rail=None, xtol=1e-7, jump=2e-4):
         raise InputError(f"contact transitions: xtol = {xtol!r} m must be positive")
     flange_angle = float(at.get("flange_angle", np.pi / 4))
     kw = dict(wheel=wheel, rail=rail, gauge=at["gauge"], inclination=at["inclination"],
-              flange_back_spacing=at["flange_back_spacing"])
+              flange_back_spacing=at["flange_back_spacing"], accept=at.get("accept", ()))
     t = table.sort_values("y [m]").reset_index(drop=True)
     if "status" in t.columns:
         ok = (t["status"] == "ok").to_numpy()
@@ -684,6 +690,16 @@ def flange_contact_onset(table, wheel=None, rail=None, exact=True, xtol=1e-7, tr
     (y_flange [m], gamma [rad]) or (nan, nan) when the table shows no flange contact.  With
     ``exact`` y_flange is the midpoint of the final interval and gamma the contact angle at
     its flange end.
+
+    Raises
+    ------
+    core.errors.InputError
+        The left wheel is in flange contact already at the row before the first positive shift
+        with flange contact (the wheelset does not fit between the rails), or ``transitions``
+        are not of this table (the message names the profiles, the gauge and the rows).
+    core.errors.NumericalFailure
+        With ``exact``: the rigid contact failed inside the bracketing rows, so the bisection
+        stopped; the message gives the interval reached (``exact=False`` gives the first row).
     """
     t = _ok_rows(table).sort_values("y [m]")
     pos = t[t["y [m]"] > 0]
@@ -703,8 +719,27 @@ def flange_contact_onset(table, wheel=None, rail=None, exact=True, xtol=1e-7, tr
     else:
         tr = contact_transitions(pair, wheel=wheel, rail=rail, xtol=xtol)
     tr = tr[(tr["side"] == "left") & (tr["kind"] == "flange contact") & tr["flange_after"]]
-    if tr.empty or tr["status"].iloc[0] != "ok":
-        raise RuntimeError(f"flange contact onset: the bisection between {y_a!r} and {y_b!r} m "
-                           "failed" + ("" if tr.empty else f" ({tr['status'].iloc[0]})"))
+    at = table.attrs
+    what = (f"wheel {wheel.name if wheel is not None else at.get('wheel', 'S1002')} on rail "
+            f"{rail.name if rail is not None else at.get('rail', 'UIC60')}"
+            + (f", gauge {float(at['gauge']) * 1e3:g} mm" if "gauge" in at else "")
+            + (f", flange-back spacing {float(at['flange_back_spacing']) * 1e3:g} mm"
+               if "flange_back_spacing" in at else ""))
+    rows = f"between the table rows y = {y_a * 1e3:.4f} and {y_b * 1e3:.4f} mm"
+    if bool(pair["flange_L"].iloc[0]):
+        raise InputError(f"flange contact onset of {what}: the left wheel is in flange contact already at "
+                         f"y = {y_a * 1e3:.4f} mm, before the first positive shift: the wheelset does not fit "
+                         "between the rails (check the gauge, the flange-back spacing and the profiles)")
+    if tr.empty:
+        raise InputError(f"flange contact onset of {what}: the transitions given have no flange-contact "
+                         f"transition of the left wheel {rows}: pass contact_transitions() of this table, "
+                         "or none")
+    if tr["status"].iloc[0] != "ok":
+        lo, hi = float(tr["y_before [m]"].iloc[0]), float(tr["y_after [m]"].iloc[0])
+        raise NumericalFailure(
+            f"flange contact onset of {what}: not located {rows}: the rigid contact within them failed "
+            f"({tr['status'].iloc[0].removeprefix('not located: ')}); the onset lies between "
+            f"{lo * 1e3:.4f} and {hi * 1e3:.4f} mm (exact=False gives the first row with flange contact, "
+            f"{y_b * 1e3:.4f} mm)")
     r = tr.iloc[0]
     return float(r["y [m]"]), float(r["gamma_after [rad]"])

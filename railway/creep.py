@@ -602,14 +602,22 @@ class Polach2005(CreepModel):
 
     def __init__(self, k_A: float = 1.0, k_S: float = 1.0, A: float = 1.0, B: float = 0.0,
                  speed: float = 20.0, join: str = "scaled"):
+        vals = {}
+        for key, val in (("k_A", k_A), ("k_S", k_S), ("A", A), ("B", B), ("speed", speed)):
+            if isinstance(val, bool) or not isinstance(val, (int, float, np.integer, np.floating)):
+                raise InputError(f"Polach 2005 parameter {key} = {val!r} is not a number")
+            vals[key] = float(val)
+        k_A, k_S, A, B, speed = (vals[k] for k in ("k_A", "k_S", "A", "B", "speed"))
         if not (0.0 < k_S <= k_A <= 1.0):
-            raise InputError(f"Polach 2005 needs 0 < k_S <= k_A <= 1, got k_A={k_A!r}, k_S={k_S!r}")
+            raise InputError(f"Polach 2005 needs 0 < k_S <= k_A <= 1 (reduction factors of Kalker's slope), "
+                             f"got k_A={k_A}, k_S={k_S}")
         if not (0.0 < A <= 1.0):
-            raise InputError(f"Polach 2005 friction ratio A must lie in (0, 1], got {A!r}")
-        if not (B >= 0.0):
-            raise InputError(f"Polach 2005 friction decay B must be >= 0 s/m, got {B!r}")
-        if not (speed > 0.0):
-            raise InputError(f"Polach 2005 speed must be > 0 m/s, got {speed!r}")
+            raise InputError(f"Polach 2005 friction ratio A must lie in (0, 1], got {A} (A = mu_inf / mu_0: "
+                             "friction falls with the slip velocity)")
+        if not (0.0 <= B < np.inf):
+            raise InputError(f"Polach 2005 friction decay B must be >= 0 s/m and finite, got {B}")
+        if not (0.0 < speed < np.inf):
+            raise InputError(f"Polach 2005 speed must be > 0 m/s and finite, got {speed}")
         self.k_A, self.k_S, self.A, self.B, self.speed, self.join = k_A, k_S, A, B, speed, join
 
     @classmethod

@@ -16,6 +16,7 @@ import pandas as pd
 
 from core.contact_laws import hertz_from_load
 from core.errors import InputError
+from core.inputs import closest
 
 from .creep import get_creep_model
 
@@ -88,7 +89,8 @@ def creep_curve(models="polach2000", creepage: str = "xi", values=None, *, norma
         "N [N]", "a [m]", "b [m]", "G [Pa]", "nu [-]", "mu [-]".
     """
     if creepage not in _CREEPAGES:
-        raise ValueError(f"creepage must be one of {sorted(_CREEPAGES)}, got {creepage!r}")
+        raise InputError(f"creep curve: creepage {creepage!r} is not one of {sorted(_CREEPAGES)}"
+                         f"{closest(str(creepage), sorted(_CREEPAGES))}")
     try:
         N = float(normal_force)
     except (TypeError, ValueError):
@@ -113,7 +115,8 @@ def creep_curve(models="polach2000", creepage: str = "xi", values=None, *, norma
                     accept=accept)
     if a is None or b is None:
         if A is None or B is None or E is None:
-            raise ValueError("give the semi-axes a, b or the curvatures A, B with E")
+            raise InputError(f"creep curve: give the semi-axes a and b, or the curvatures A and B with Young's "
+                             f"modulus E (got a={a!r}, b={b!r}, A={A!r}, B={B!r}, E={E!r})")
         a, b = semi_axes_from_curvatures(normal_force, A, B, E, nu)
     else:
         for key, val in (("a", a), ("b", b)):
@@ -126,14 +129,16 @@ def creep_curve(models="polach2000", creepage: str = "xi", values=None, *, norma
                     + (" -- was it given in millimetres?" if v > SEMI_AXIS_RANGE[1] else ""))
     if G is None:
         if E is None:
-            raise ValueError("give G or E")
+            raise InputError("creep curve: give the shear modulus G or Young's modulus E (both are None), e.g. "
+                             "G=8e10 (Pa) for steel")
         G = E / (2.0 * (1.0 + nu))
     if values is None:
         lim = 2.0 if creepage == "phi" else 0.01
         values = np.linspace(-lim, lim, 101)
     values = np.asarray(values, dtype=float)
     if values.ndim != 1 or values.size == 0:
-        raise ValueError(f"values must be a non-empty 1-D array, got shape {values.shape}")
+        raise InputError(f"creep curve: values (the swept {creepage}) must be a non-empty 1-D array, got shape "
+                         f"{values.shape}")
     if values.size:
         R.check("spin_creepage" if creepage == "phi" else "creepage", [values.min(), values.max()],
                 where=f"creep curve: swept {creepage} (smallest, largest)", accept=accept)

@@ -34,6 +34,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from core.errors import InputError
+
 __all__ = ["creepages", "contact_frame"]
 
 
@@ -42,10 +44,10 @@ def _vec3(name: str, value, n: int | None = None) -> np.ndarray:
     if arr.ndim == 1:
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ValueError(f"{name} must have shape (n, 3) or (3,), got {np.shape(value)}")
+        raise InputError(f"creepages: {name} must have shape (n, 3) or (3,), got {np.shape(value)}")
     if np.any(~np.isfinite(arr)):
         i = int(np.argwhere(~np.isfinite(arr))[0, 0])
-        raise ValueError(f"{name} has a non-finite value at contact {i}: {arr[i].tolist()}")
+        raise InputError(f"creepages: {name} has a non-finite value at contact {i}: {arr[i].tolist()}")
     return arr
 
 
@@ -72,14 +74,14 @@ def contact_frame(normal, rolling_direction, tol: float = 1e-6):
     nrm, d = np.broadcast_arrays(nrm, d)
     ln = np.linalg.norm(nrm, axis=1)
     if np.any(ln < tol):
-        raise ValueError(f"normal has zero length at contact {int(np.flatnonzero(ln < tol)[0])}")
+        raise InputError(f"creepages: normal has zero length at contact {int(np.flatnonzero(ln < tol)[0])}")
     nrm = nrm / ln[:, None]
     t = d - np.sum(d * nrm, axis=1)[:, None] * nrm
     lt = np.linalg.norm(t, axis=1)
     bad = lt < tol * np.maximum(np.linalg.norm(d, axis=1), 1e-300)
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
-        raise ValueError(f"rolling_direction is (nearly) parallel to the normal or zero at contact {i}")
+        raise InputError(f"creepages: rolling_direction is (nearly) parallel to the normal or zero at contact {i}")
     t = t / lt[:, None]
     l = np.cross(nrm, t)
     return t, l, nrm
@@ -140,7 +142,7 @@ def creepages(contact_point, normal, rolling_direction, wheel_position, wheel_ve
         V = np.broadcast_to(np.asarray(rolling_speed, dtype=float), (rc.shape[0],)).copy()
     if np.any(~(V >= min_rolling_speed)):
         i = int(np.flatnonzero(~(V >= min_rolling_speed))[0])
-        raise ValueError(f"rolling speed V={float(V[i])!r} m/s at contact {i} is below "
+        raise InputError(f"creepages: rolling speed V={float(V[i])!r} m/s at contact {i} is below "
                          f"min_rolling_speed={min_rolling_speed} m/s: creepages undefined")
     xi = np.sum(dv * t, axis=1) / V
     eta = np.sum(dv * l, axis=1) / V

@@ -60,6 +60,7 @@ __all__ = [
     "s1002_exact",
     "uic60_exact",
     "read_profile_file",
+    "rail_crown_problem",
     "data_resolution",
     "R0_RANGE",
     "MIN_FLANGE_HEIGHT",
@@ -227,6 +228,53 @@ def uic60_exact(u):
 MIN_PROFILE_SPAN_MM = 5.0
 
 
+#: Half-width (m) of the probe around the highest point of a rail head that measures its crown
+#: radius: UIC60 falls by 0.015 mm over it (R300), a flat head by nothing, a V by millimetres.
+CROWN_PROBE = 0.003
+
+
+def rail_crown_problem(profile) -> str:
+    """What keeps ``profile`` from being a rail head with a crown, or "" when it has one.
+
+    A rail head rises to one highest point (its crown) inside the profile and falls on both
+    sides of it with a crown radius R = d^2 / (drop_left + drop_right) over d =
+    :data:`CROWN_PROBE` within the plausible range of ``profile_lateral_radius``
+    (``data/railway/plausible_ranges.csv``): a flat head (R beyond it) has no crown on which a
+    wheel's contact could settle and no top at an inclination, a V-shaped one (R below it) a knife
+    edge.
+    """
+    from .ranges import ranges
+
+    rng = ranges()["profile_lateral_radius"]
+    u = np.linspace(profile.x_min, profile.x_max, 4001)
+    v = profile.poly(u)[0]
+    width = (u[-1] - u[0]) / _MM
+    if not np.all(np.isfinite(v)):
+        return "the fitted profile is not finite"
+    if float(np.ptp(v)) < 1e-5:
+        return (f"it is flat (its heights vary by {float(np.ptp(v)) / _MM:.3g} mm over its width of "
+                f"{width:.4g} mm); a rail head rises to a rounded crown (UIC60: R300)")
+    i = int(np.argmax(v))
+    ut = float(u[i])
+    if ut - CROWN_PROBE < u[0] or ut + CROWN_PROBE > u[-1]:
+        edge = "first" if ut - CROWN_PROBE < u[0] else "last"
+        return (f"its highest point, u = {ut / _MM:.4g} mm, lies within {CROWN_PROBE / _MM:g} mm of its "
+                f"{edge} point: the heights rise towards the edge instead of falling on both sides of a "
+                "crown (are they depths? read the file with vertical='depth')")
+    vl, vr = profile.poly(np.array([ut - CROWN_PROBE, ut + CROWN_PROBE]))[0]
+    drop = float(2.0 * v[i] - vl - vr)
+    R = CROWN_PROBE**2 / drop if drop > 0 else np.inf
+    where = (f"within +-{CROWN_PROBE / _MM:g} mm of its highest point (u = {ut / _MM:.4g} mm) it falls by "
+             f"{drop / 2 / _MM:.3g} mm on average")
+    if R > rng.high:
+        return (f"it is flat at the top: {where} (crown radius {R:.4g} m, above {rng.high:g} m); a rail head "
+                "has a rounded crown (UIC60: R300 mm)")
+    if R < rng.low:
+        return (f"it comes to a point (V-shaped): {where} (crown radius {R / _MM:.3g} mm, below "
+                f"{rng.low / _MM:g} mm); a rail head has a rounded crown (UIC60: R300 mm)")
+    return ""
+
+
 def _validate_xy(x, z, source):
     x = np.asarray(x, dtype=float)
     z = np.asarray(z, dtype=float)
@@ -238,7 +286,7 @@ def _validate_xy(x, z, source):
         bad = ~np.isfinite(a)
         if np.any(bad):
             i = int(np.argmax(bad))
-            raise InputError(f"{source}: {name} coordinate of point {i} is {a[i]!r} (not finite)")
+            raise InputError(f"{source}: {name} coordinate of point {i} is {float(a[i])} (not finite)")
     span = float(np.ptp(x))
     if span < MIN_PROFILE_SPAN_MM and float(np.max(np.abs(np.concatenate([x, z])))) < 1.0:
         raise InputError(
@@ -256,7 +304,7 @@ def _validate_xy(x, z, source):
         i = int(np.argmax(sign * dx <= 0)) + 1
         raise InputError(
             f"{source}: lateral coordinate is not strictly monotonic at point {i} "
-            f"(value {x[i]!r} after {x[i - 1]!r}); trim the profile to a graph over the lateral "
+            f"(value {float(x[i])} after {float(x[i - 1])}); trim the profile to a graph over the lateral "
             f"coordinate")
     return x, z
 
@@ -265,22 +313,33 @@ def read_profile_file(path):
     """Read a two-column profile file (lateral, vertical in mm); returns two arrays in mm."""
     path = Path(path)
     xs, zs = [], []
-    with open(path, encoding="utf-8") as fh:
-        for lineno, line in enumerate(fh, 1):
-            s = line.strip()
-            if not s or s.startswith("#"):
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise DataFileError(f"{path}: not a text profile file (byte {raw[exc.start]:#04x} at offset "
+                            f"{exc.start} is not UTF-8; expected two columns, lateral and vertical in "
+                            "mm)") from None
+    if "\x00" in text:
+        raise DataFileError(f"{path}: not a text profile file (it contains NUL bytes; expected two "
+                            "columns, lateral and vertical in mm)")
+    for lineno, line in enumerate(text.splitlines(), 1):
+        s = line.strip()
+        if not s or s.startswith("#"):
+            continue
+        parts = [p for p in re.split(r"[,;\s]+", s) if p]
+        if len(parts) < 2:
+            raise DataFileError(f"{path}:{lineno}: expected two columns, got {s!r}")
+        try:
+            a, b = float(parts[0]), float(parts[1])
+        except ValueError:
+            if not xs:  # header line
                 continue
-            parts = [p for p in re.split(r"[,;\s]+", s) if p]
-            if len(parts) < 2:
-                raise DataFileError(f"{path}:{lineno}: expected two columns, got {s!r}")
-            try:
-                a, b = float(parts[0]), float(parts[1])
-            except ValueError:
-                if not xs:  # header line
-                    continue
-                raise DataFileError(f"{path}:{lineno}: non-numeric value in {s!r}") from None
-            xs.append(a)
-            zs.append(b)
+            raise DataFileError(f"{path}:{lineno}: non-numeric value in {s!r}") from None
+        if not (np.isfinite(a) and np.isfinite(b)):
+            raise DataFileError(f"{path}:{lineno}: point ({a}, {b}) is not finite (in {s!r})")
+        xs.append(a)
+        zs.append(b)
     if not xs:
         raise DataFileError(f"{path}: no profile points found")
     return np.array(xs), np.array(zs)
@@ -581,7 +640,11 @@ class RailProfile(ProfileCurve):
         u, v = _validate_xy(u, v, source)
         res = data_resolution(v) if resolution is None else float(resolution)
         v = v - np.max(v)
-        return cls(_spline_ppoly(u * _MM, v * _MM, smoothing), name=name, resolution=res * _MM)
+        prof = cls(_spline_ppoly(u * _MM, v * _MM, smoothing), name=name, resolution=res * _MM)
+        problem = rail_crown_problem(prof)
+        if problem:
+            raise InputError(f"{source}: rail head has no crown: {problem}")
+        return prof
 
     @classmethod
     def from_file(cls, path, **kw):

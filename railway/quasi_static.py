@@ -69,7 +69,7 @@ def _contact_forces(res, E, nu):
 
 def quasi_static_contact(lateral, wheel_load, yaw=0.0, wheel=None, rail=None, gauge=1.435,
                          inclination=1 / 40, flange_back_spacing=1.360, E=2.1e11, nu=0.28,
-                         tol=None, max_iter=50):
+                         tol=None, max_iter=50, accept=()):
     """Wheelset position under vertical wheel loads and the forces of every contact.
 
     Parameters
@@ -80,8 +80,9 @@ def quasi_static_contact(lateral, wheel_load, yaw=0.0, wheel=None, rail=None, ga
         Vertical load Q per wheel (N), > 0.
     yaw : float
         Yaw angle (rad).
-    wheel, rail, gauge, inclination, flange_back_spacing :
-        As in :func:`railway.contact_geometry.rigid_contact`.
+    wheel, rail, gauge, inclination, flange_back_spacing, accept :
+        As in :func:`railway.contact_geometry.rigid_contact` (``accept=["gauge"]`` for a gauge
+        outside its plausible range).
     E, nu : float
         Young's modulus (Pa) and Poisson ratio of wheel and rail.
     tol : float, optional
@@ -113,7 +114,7 @@ def quasi_static_contact(lateral, wheel_load, yaw=0.0, wheel=None, rail=None, ga
         raise InputError(f"quasi-static contact: lateral shift {y[~np.isfinite(y)][0]!r} is not finite")
     wheel = wheel if wheel is not None else WheelProfile.s1002()
     z_all, roll_all, rig, _ = rigid_contact(y, yaw, wheel, rail, gauge, inclination,
-                                            flange_back_spacing, errors="mark")
+                                            flange_back_spacing, errors="mark", accept=accept)
     rig_status = rig.extra["status"]
     ok = rig_status == "ok"
     y_all = y
@@ -121,7 +122,7 @@ def quasi_static_contact(lateral, wheel_load, yaw=0.0, wheel=None, rail=None, ga
     n = y.size
     if n == 0:
         return _assemble([], y_all, rig_status, wheel, Q, yaw)
-    mount = RailMounting(rail, gauge=gauge, inclination=inclination)
+    mount = RailMounting(rail, gauge=gauge, inclination=inclination, accept=accept)
     track = Track.straight(20.0)
     cs = ContactSearch(track, wheel=wheel, rails=mount, n_wheelsets=3 * n,
                        flange_back_spacing=flange_back_spacing, tol_linear=1e-9)

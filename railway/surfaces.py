@@ -42,6 +42,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from core.errors import InputError
+
 from .profiles import WheelProfile
 from .track import RailMounting, Track
 
@@ -63,9 +65,10 @@ class WheelSurface:
 
     def __init__(self, profile: WheelProfile, side=1, flange_back_spacing=1.360):
         if side not in (1, -1):
-            raise ValueError(f"wheel side must be +1 (left) or -1 (right), got {side!r}")
+            raise InputError(f"wheel surface: side must be +1 (left) or -1 (right), got {side!r}")
         if not (np.isfinite(flange_back_spacing) and 1.0 < flange_back_spacing < 2.0):
-            raise ValueError(f"flange-back spacing {flange_back_spacing!r} m is not plausible")
+            raise InputError(f"wheel surface: flange-back spacing {flange_back_spacing!r} m is not plausible "
+                             "(expected 1 to 2 m, e.g. 1.360; it is in metres)")
         self.profile = profile
         self.side = int(side)
         self.L = 0.5 * float(flange_back_spacing) - profile.y_back
@@ -117,7 +120,7 @@ class RailSurface:
 
     def __init__(self, track: Track, mounting: RailMounting, side=1):
         if side not in (1, -1):
-            raise ValueError(f"rail side must be +1 (left) or -1 (right), got {side!r}")
+            raise InputError(f"rail surface: side must be +1 (left) or -1 (right), got {side!r}")
         self.track = track
         self.mounting = mounting
         self.side = int(side)

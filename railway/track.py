@@ -73,7 +73,7 @@ from core.curves import (
     TabulatedFramedCurve,
     quintic_hermite_coeffs,
 )
-from core.errors import InputError
+from core.errors import DataRangeError, InputError
 
 from .profiles import RailProfile
 
@@ -498,12 +498,41 @@ class Track(FramedCurve):
         return self.frame_table.table
 
     # -- evaluation ---------------------------------------------------------------------
-    def evaluate(self, s) -> TrackFrame:
+    #: arc length (m) by which an evaluation may pass an end of an open track as round-off
+    END_TOLERANCE = 1e-9
+
+    def evaluate(self, s, extrapolate=False) -> TrackFrame:
         """Track frame and derivatives at arc lengths s (m), any 1-D array.
 
-        Assembled exactly from the base table (R orthonormal to round-off); raises ValueError
-        naming a non-finite arc length.
+        Assembled exactly from the base table (R orthonormal to round-off).
+
+        Parameters
+        ----------
+        s : float or array_like
+            Arc lengths (m), within [0, ``length``] of an open track.
+        extrapolate : bool
+            For internal callers that look a little past an end on purpose (a search seed, a
+            placement or a projection with a margin): continue the track with its end pieces.
+
+        Raises
+        ------
+        core.errors.InputError
+            A non-finite arc length (named).
+        core.errors.DataRangeError
+            An arc length beyond the ends of an open track (the end and s named); raised during
+            a run it ends the run as failed, keeping what was computed.
         """
+        s = np.atleast_1d(np.asarray(s, dtype=float)).reshape(-1)
+        if not (extrapolate or self.closed):
+            tol = self.END_TOLERANCE * max(1.0, self.length)
+            with np.errstate(invalid="ignore"):
+                out = (s < -tol) | (s > self.length + tol)
+            if np.any(out):
+                i = int(np.argmax(out))
+                end = ("before its start at s = 0 m" if s[i] < 0 else f"beyond its end at s = {self.length:g} m")
+                raise DataRangeError(f"{self.name}: evaluated at s[{i}] = {float(s[i]):g} m, {end}: the track "
+                                     f"is open (0 <= s <= {self.length:g} m) and is not extrapolated; make it "
+                                     "longer or keep the vehicle on it")
         return super().evaluate(s)
 
     def _evaluate(self, s):
@@ -597,11 +626,6 @@ def parse_inclination(value):
     return value
 
 
-#: Plausible track gauges (m): from 15-inch minimum gauge (0.381 m) to Indian broad gauge
-#: (1.676 m), with margin; a value outside is taken for a unit slip.
-GAUGE_RANGE = (0.3, 2.0)
-
-
 class RailMounting:
     """A rail profile inclined towards the track centre and placed at the given gauge.
 
@@ -615,6 +639,9 @@ class RailMounting:
         tan(alpha) towards the track centre (1/40 default, "1:20", "vertical").
     gauge_depth : float
         Depth of the gauge point below the top of rail (m), default 0.014.
+    accept : sequence of str
+        Quantities whose plausible range is not enforced: ``["gauge"]`` for a gauge outside the
+        ``gauge`` row of ``data/railway/plausible_ranges.csv`` (a deliberate outlier).
 
     Attributes
     ----------
@@ -626,16 +653,16 @@ class RailMounting:
         Profile coordinate of the gauge point.
     """
 
-    def __init__(self, profile=None, gauge=1.435, inclination=1 / 40, gauge_depth=0.014):
+    def __init__(self, profile=None, gauge=1.435, inclination=1 / 40, gauge_depth=0.014, accept=()):
+        from .ranges import ranges
+
         self.profile = profile if profile is not None else RailProfile.uic60()
         for key, val in (("gauge", gauge), ("gauge_depth", gauge_depth)):
             if not np.isfinite(val) or val <= 0:
                 raise InputError(f"rail mounting: {key} = {val!r} must be positive and finite")
-        if not (GAUGE_RANGE[0] <= gauge <= GAUGE_RANGE[1]):
-            raise InputError(
-                f"rail mounting: gauge = {gauge!r} m is implausible (expected {GAUGE_RANGE[0]:g} to "
-                f"{GAUGE_RANGE[1]:g} m, e.g. 1.435); the gauge is in metres"
-                + (" -- was it given in millimetres?" if gauge > GAUGE_RANGE[1] else ""))
+        accept = (accept,) if isinstance(accept, str) else tuple(accept)
+        gauge = ranges().check("gauge", gauge, where="rail mounting: gauge", accept=accept)
+        self.accept = accept
         if not (0.0 < gauge_depth < 0.05):
             raise InputError(f"rail mounting: gauge_depth = {gauge_depth!r} m is implausible (expected "
                              "below 0.05 m, e.g. 0.014); it is in metres")
@@ -645,6 +672,11 @@ class RailMounting:
         al = np.arctan(self.inclination)
         self.ca, self.sa = float(np.cos(al)), float(np.sin(al))
         p = self.profile
+        from .profiles import rail_crown_problem
+
+        problem = rail_crown_problem(p)
+        if problem:
+            raise InputError(f"rail mounting: profile {p.name}: rail head has no crown: {problem}")
         u = np.linspace(p.x_min, p.x_max, 20001)
         v, v1, _ = p.evaluate(u)
         a1 = self.ca - v1 * self.sa
@@ -660,7 +692,8 @@ class RailMounting:
         Z = u * self.sa + v * self.ca
         i_top = int(np.argmax(Z))
         # refine the top (dZ/du = 0) and the gauge point (Z = Z_top - depth on the gauge side)
-        ut = self._newton(u[i_top], lambda x: self._mounted(x)[3], lambda x: self._mounted(x)[5])
+        ut = self._newton(u[i_top], lambda x: self._mounted(x)[3], lambda x: self._mounted(x)[5],
+                          what=f"the top of the inclined profile {p.name}")
         z_top = self._mounted(ut)[1]
         target = z_top - self.gauge_depth
         m = (u < ut) & (u >= self.u_min)
@@ -670,7 +703,7 @@ class RailMounting:
                              f"below its top on the gauge side")
         ug0 = u[j[-1]]
         ug = self._newton(ug0, lambda x: self._mounted(x)[1] - target,
-                          lambda x: self._mounted(x)[3])
+                          lambda x: self._mounted(x)[3], what=f"the gauge point of the profile {p.name}")
         self.u_top, self.u_gauge = float(ut), float(ug)
         yo_g = self._mounted(ug)[0]
         self.Y0 = 0.5 * self.gauge - yo_g
@@ -682,15 +715,25 @@ class RailMounting:
         ca, sa = self.ca, self.sa
         return (u * ca - v * sa, u * sa + v * ca, ca - v1 * sa, sa + v1 * ca, -v2 * sa, v2 * ca)
 
-    @staticmethod
-    def _newton(x, f, df, n=30):
-        x = float(x)
+    def _newton(self, x, f, df, n=30, what="a point of the rail profile"):
+        """Newton on f(x) = 0 from the grid point x; a zero or non-finite slope, or an iterate that
+        leaves the profile, is a profile without that point (InputError naming it)."""
+        x = x0 = float(x)
+        lo, hi = self.profile.x_min, self.profile.x_max
         for _ in range(n):
-            dx = float(f(x)) / float(df(x))
-            x -= dx
-            if abs(dx) < 1e-15:
+            fx, dfx = float(f(x)), float(df(x))
+            if not (np.isfinite(fx) and np.isfinite(dfx)) or dfx == 0.0:
                 break
-        return x
+            dx = fx / dfx
+            x -= dx
+            if not lo <= x <= hi:
+                break
+            if abs(dx) < 1e-15:
+                return x
+        else:
+            return x
+        raise InputError(f"rail mounting: cannot locate {what} near u = {x0 * 1e3:.4g} mm (the profile is "
+                         "not a smooth convex rail head there)")
 
     def mounted(self, u):
         """Mounted profile (Yo, Z, dYo/du, dZ/du, d2Yo/du2, d2Z/du2) at u (m), in the track

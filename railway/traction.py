@@ -23,7 +23,9 @@ curve without cant change).
 Search state: the arc length s of the body is found by Newton's method from its value at the
 last accepted step (core's search-state rule, :mod:`core.forces.protocol`); the result is the
 foot of the perpendicular to 1e-10 m whatever the start, so the force is a function of
-(t, q, v).
+(t, q, v).  An open track is not extrapolated: a body whose foot of the perpendicular lies beyond
+its ends raises :class:`core.errors.DataRangeError` naming the end (the compiled kernel reports
+the element as failed), which ends a run as failed with what was computed kept.
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ import numpy as np
 from core.compiled.protocol import ELEMENT_FAILED, OK, accept_kernel, force_kernel
 from core.compiled.timefunctions import evaluate as tf_evaluate
 from core.drivers import as_time_function
-from core.errors import ModelError, NumericalFailure
+from core.errors import DataRangeError, ModelError, NumericalFailure
 from core.forces.protocol import ForceElement, ForceEval, ForceJacobian, ForceKind, nonnegative
 
 from .wheel_rail_compiled import _project
@@ -80,6 +82,7 @@ class TrackSpeedControlKind(ForceKind):
         if ctx.space.dim != 3:
             raise ModelError(f"track speed control {elements[0].name!r}: needs a spatial model")
         self.names = [e.name for e in elements]
+        self.body_names = [e.body for e in elements]
         self.b = np.array([ctx.index(e.body, e.name) for e in elements], np.int64)
         self.tracks = [e.track for e in elements]
         self.V = [as_time_function(e.speed, f"speed of {e.name!r}") for e in elements]
@@ -102,6 +105,13 @@ class TrackSpeedControlKind(ForceKind):
                 s[i] = tr.project(r, g)[0]
             except NumericalFailure as exc:
                 raise NumericalFailure(f"track speed control {self.names[i]!r}: {exc}") from None
+            L = float(tr.length)
+            if not getattr(tr, "closed", False) and not (0.0 <= s[i] <= L):
+                end = ("off the start of the track at s = 0 m" if s[i] < 0.0
+                       else f"past the end of the track at s = {L:g} m")
+                raise DataRangeError(f"track speed control {self.names[i]!r}: body {self.body_names[i]!r} ran {end} "
+                                     f"(s = {s[i]:.6g} m): the track is open and is not extrapolated; make it "
+                                     "longer or the run shorter")
         return s
 
     def _terms(self, bs, t):

@@ -68,6 +68,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from core.errors import InputError
+
 from .contact_geometry import rigid_contact
 from .contact_search import FLANGE, TREAD
 from .profiles import WheelProfile, s1002_exact, _load_s1002
@@ -99,9 +101,10 @@ def conical_wheel_points(cone=1 / 40, root_radius_mm=8.0, y_min_mm=-62.0, y_max_
         Tangent point of the root arc on the flank (mm): boundary of the convex flange zone.
     """
     if not (0.0 < cone < 0.5):
-        raise ValueError(f"cone = {cone!r} must lie in (0, 0.5)")
+        raise InputError(f"two-point wheel: cone = {cone!r} must lie in (0, 0.5) (tan of the tread cone, e.g. 0.025 "
+                         "for 1:40)")
     if not (0.0 < root_radius_mm < 30.0):
-        raise ValueError(f"root_radius_mm = {root_radius_mm!r} must lie in (0, 30) mm")
+        raise InputError(f"two-point wheel: root_radius_mm = {root_radius_mm!r} must lie in (0, 30) mm")
     rows = {name: coef for name, _, _, coef in _load_s1002()}
     AE, BE = rows["E"][0], rows["E"][1]
     R, c = float(root_radius_mm), float(cone)
@@ -111,7 +114,7 @@ def conical_wheel_points(cone=1 / 40, root_radius_mm=8.0, y_min_mm=-62.0, y_max_
     y_t1 = yc - R * c / q1
     y_t2 = yc - R * BE / q2
     if not y_t2 < y_t1:
-        raise ValueError(f"cone = {cone!r}, root_radius_mm = {root_radius_mm!r}: no concave root arc joins "
+        raise InputError(f"two-point wheel: cone = {cone!r}, root_radius_mm = {root_radius_mm!r}: no concave root arc joins "
                          "the tread to the flank")
     y = np.arange(y_min_mm, y_max_mm + 0.5 * step_mm, step_mm)
     F = np.empty_like(y)
@@ -192,13 +195,13 @@ def two_point_contact(wheel, yaw=0.0, rail=None, gauge=1.435, inclination=1 / 40
     f = np.where(np.isfinite(gF), gF, 1.0) - np.where(np.isfinite(gT), gT, 1.0)
     ch = np.flatnonzero((f[:-1] > 0) & (f[1:] <= 0))
     if ch.size == 0:
-        raise ValueError(f"{wheel.name}: no two-point contact (tread and flange touching together) "
+        raise InputError(f"{wheel.name}: no two-point contact (tread and flange touching together) "
                          f"for lateral shifts in [0, {y_max!r}] m at yaw {yaw!r} rad")
     k = int(ch[0])
     # g_F - g_T changes sign continuously only where neither gap is infinite (both candidates
     # valid); a change across an invalid candidate is a jump (S1002 runs across its root)
     if not (np.isfinite(gT[k]) and np.isfinite(gF[k]) and np.isfinite(gT[k + 1]) and np.isfinite(gF[k + 1])):
-        raise ValueError(f"{wheel.name}: tread or flange candidate vanishes at the flange onset "
+        raise InputError(f"{wheel.name}: tread or flange candidate vanishes at the flange onset "
                          f"(shift {float(ys[k])!r}..{float(ys[k + 1])!r} m): the contact runs across the flange "
                          "root, no two-point contact")
 

@@ -101,6 +101,8 @@ class VehicleDefinition:
     bump_stop: dict | None = None
     yaw_dampers: list = field(default_factory=list)
     path: str = ""
+    #: quantities whose plausible range was waived when the definition was read (e.g. "gauge")
+    accept: tuple = ()
 
     @classmethod
     def from_toml(cls, path, accept=()) -> VehicleDefinition:
@@ -167,7 +169,7 @@ class VehicleDefinition:
         return dz1, dz2
 
     def rails(self):
-        return RailMounting(self.rail, gauge=self.gauge, inclination=self.inclination)
+        return RailMounting(self.rail, gauge=self.gauge, inclination=self.inclination, accept=self.accept)
 
 
 @dataclass

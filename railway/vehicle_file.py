@@ -466,7 +466,7 @@ def vehicle_kwargs(data: dict, *, source: str = "vehicle definition", base_dir=N
                 geometry=g, car_body=body(vf.car_body), bogie=body(vf.bogie), wheelset=body(vf.wheelset),
                 primary=susp(vf.primary), secondary=secondary,
                 anti_roll_bar=vf.anti_roll_bar.stiffness if vf.anti_roll_bar is not None else 0.0,
-                bump_stop=bump, yaw_dampers=yds)
+                bump_stop=bump, yaw_dampers=yds, accept=tuple(acc))
 
 
 def read_vehicle_file(path, accept=()) -> dict:

@@ -45,7 +45,7 @@ def _start(wheel, rails, y0, E, nu):
     from core.contact_laws import hertz_from_load
 
     z, roll, res, act = rigid_contact([y0], wheel=wheel, rail=rails.profile, gauge=rails.gauge,
-                                      inclination=rails.inclination)
+                                      inclination=rails.inclination, accept=getattr(rails, "accept", ()))
     i = np.arange(2)
     c = act[0]
     A = 0.5 * (res.k_wheel_rolling + res.k_rail_rolling)[i, c]
@@ -173,7 +173,8 @@ def linear_wheelset(k_y, k_psi, wheel=None, rails=None, E=2.1e11, nu=0.28, dy=1e
 
     wheel = wheel if wheel is not None else WheelProfile.s1002()
     rails = rails if rails is not None else RailMounting()
-    geo = dict(wheel=wheel, rail=rails.profile, gauge=rails.gauge, inclination=rails.inclination)
+    geo = dict(wheel=wheel, rail=rails.profile, gauge=rails.gauge, inclination=rails.inclination,
+               accept=getattr(rails, "accept", ()))
     ys = np.linspace(-dy, dy, 21)
     tab = contact_geometry_table(ys, **geo)
     lam = float(np.polyfit(ys, tab["delta_r [m]"], 1)[0] / 2.0)

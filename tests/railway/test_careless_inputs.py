@@ -161,8 +161,7 @@ FILE_CASES = [
      r"outside the plausible range 0\.4 m \.\.\. 1\.6 m"),
     ("bogie cg above car body cg", [("car_body_cg_height = 1.8 ", "car_body_cg_height = 0.55 ")], "", DataFileError,
      rf"{F} \[geometry\]: bogie_cg_height 0\.6 m >= car_body_cg_height 0\.55 m"),
-    ("all masses in tonnes, ranges waived: axle load", [("mass = 32000.0", "mass = 32"), ("mass = 2615.0", "mass = 2.615"),
-                                                        ("mass = 1813.0", "mass = 1.813")],
+    ("all masses in tonnes, ranges waived: axle load", [("mass = 32000.0", "mass = 32"), ("mass = 2615.0", "mass = 2.615"), ("mass = 1813.0", "mass = 1.813")],
      '\n[checks]\naccept = ["car_body_mass", "bogie_mass", "wheelset_mass"]\n', ImplausibleValueError,
      rf"{F}: the axle load \(total mass per axle\) implied by the file, .* = 0\.01112 t, .*are the masses in kg\?"),
     # profiles and names
@@ -556,3 +555,249 @@ def test_misspelt_creep_parameter(coach):
                                                  r"'kA'; did you mean 'k_A'\?"):
         build_vehicle(coach, Track.straight(100.0), s0=30.0, speed=20.0, creep_law="polach2005",
                       creep_params={"kA": 0.5})
+
+
+# ---------------------------------------------------------------------------------------------
+# follow-ups: flange-contact onset, rail crowns, profile files, library checks, gauge, track ends
+# ---------------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def onset_table():
+    from railway.contact_geometry import contact_geometry_table, contact_transitions
+
+    t = contact_geometry_table(np.linspace(0.0, 0.008, 17))
+    return t, contact_transitions(t)
+
+
+def test_flange_onset_bisection_failure_is_a_numerical_failure(onset_table):
+    from core.errors import NumericalFailure
+    from railway.contact_geometry import flange_contact_onset
+
+    t, tr = onset_table
+    y_f, _ = flange_contact_onset(t, transitions=tr)
+    assert 0.004 < y_f < 0.008
+    bad = tr.copy()
+    bad["status"] = "not located: no convergence: largest gap 1e-06 m after 40 iterations at lateral shift 0.006 m"
+    with pytest.raises(NumericalFailure, match=r"flange contact onset of wheel S1002 on rail UIC60, gauge 1435 mm, "
+                                               r"flange-back spacing 1360 mm: not located between the table rows "
+                                               r"y = \d\.\d{4} and \d\.\d{4} mm: the rigid contact within them "
+                                               r"failed \(no convergence: largest gap .*\); the onset lies between "
+                                               r".* \(exact=False gives the first row with flange contact") as info:
+        flange_contact_onset(t, transitions=bad)
+    assert not isinstance(info.value, RuntimeError) and "\n" not in str(info.value)
+    assert flange_contact_onset(t, transitions=bad, exact=False)[0] >= y_f  # the fallback still works
+
+
+def test_flange_onset_with_transitions_of_another_table(onset_table):
+    from railway.contact_geometry import flange_contact_onset
+
+    t, tr = onset_table
+    with pytest.raises(InputError, match=r"flange contact onset of wheel S1002 on rail UIC60, gauge 1435 mm.*: the "
+                                         r"transitions given have no flange-contact transition of the left wheel "
+                                         r"between the table rows y = .* mm: pass contact_transitions\(\) of this "
+                                         r"table, or none"):
+        flange_contact_onset(t, transitions=tr.iloc[0:0])
+
+
+RAIL_CROWN_CASES = [
+    ("flat", lambda u: 0.0 * u, r"rail head has no crown: it is flat \(its heights vary by 0 mm over its width of 72 mm\)"),
+    ("V-shaped", lambda u: -np.abs(u), r"rail head has no crown: it comes to a point \(V-shaped\): within \+-3 mm of "
+                                        r"its highest point \(u = 0 mm\) it falls by 3 mm on average \(crown radius "
+                                        r"1\.5 mm, below 5 mm\)"),
+    ("flat crown", lambda u: -20.0 * (u / 36.0) ** 6,
+     r"rail head has no crown: it is flat at the top: within \+-3 mm of its highest point \(u = -?[\d.]+ mm\) it falls "
+     r"by .* mm on average \(crown radius .* m, above 100 m\)"),
+    ("depths read as heights", lambda u: u * u / 60,
+     r"rail head has no crown: its highest point, u = -?36 mm, lies within 3 mm of its (first|last) point: .*"
+     r"read the file with vertical='depth'"),
+]
+
+
+@pytest.mark.parametrize("shape,pattern", [c[1:] for c in RAIL_CROWN_CASES], ids=[c[0] for c in RAIL_CROWN_CASES])
+def test_rail_profile_without_a_crown_is_refused_naming_the_file(tmp_path, shape, pattern):
+    from railway.profiles import RailProfile
+
+    u = np.arange(-36.0, 37.0)
+    f = tmp_path / "rail.txt"
+    f.write_text("".join(f"{a:g} {b:.6f}\n" for a, b in zip(u, shape(u))), encoding="utf-8")
+    with pytest.raises(InputError, match=re.escape(str(f)) + ": " + pattern) as info:
+        RailProfile.from_file(f)
+    assert not isinstance(info.value, ZeroDivisionError) and "\n" not in str(info.value)
+
+
+def test_rail_mounting_refuses_a_profile_without_a_crown():
+    """A profile made in code (not read through the reader) is checked by RailMounting itself:
+    no ZeroDivisionError from the Newton iterations on the top and the gauge point."""
+    from core.curves import PiecewisePoly
+    from railway.profiles import RailProfile
+    from railway.track import RailMounting
+
+    flat = RailProfile(PiecewisePoly(np.array([-0.036, 0.036]), np.zeros((1, 1))), name="flat head")
+    with pytest.raises(InputError, match=r"rail mounting: profile flat head: rail head has no crown: it is flat"):
+        RailMounting(flat)
+    with pytest.raises(InputError, match=r"rail mounting: profile flat head: rail head has no crown"):
+        RailMounting(flat, inclination="1:20")
+    RailMounting()  # UIC60 has its crown (R300)
+
+
+def test_profile_file_with_nan_names_the_line_with_plain_floats(tmp_path):
+    from railway.profiles import RailProfile, WheelProfile
+
+    f = tmp_path / "rail_nan.txt"
+    f.write_text("# u v\n-3 -0.1\n-1 0.0\n0 nan\n1 0.0\n3 -0.1\n", encoding="utf-8")
+    with pytest.raises(DataFileError, match=r"rail_nan\.txt:4: point \(0\.0, nan\) is not finite \(in '0 nan'\)") as info:
+        RailProfile.from_file(f)
+    assert "np.float64" not in str(info.value)
+    with pytest.raises(InputError, match=r"mine: vertical coordinate of point 2 is nan \(not finite\)") as info:
+        RailProfile.from_points([-3.0, -1.0, 0.0, 1.0, 3.0], [0.0, 0.1, np.nan, 0.1, 0.0], name="mine")
+    assert "np.float64" not in str(info.value)
+    g = tmp_path / "wheel_back.txt"
+    g.write_text("-10 1\n-5 0.5\n-7.25 0.3\n0 0\n5 -0.1\n", encoding="utf-8")
+    with pytest.raises(InputError, match=r"wheel_back\.txt: lateral coordinate is not strictly monotonic at point 2 "
+                                         r"\(value -7\.25 after -5\.0\)") as info:
+        WheelProfile.from_file(g, r0=0.46)
+    assert "np.float64" not in str(info.value)
+
+
+@pytest.mark.parametrize("reader", ["rail", "wheel"])
+def test_binary_profile_file_is_named(tmp_path, reader):
+    from railway.profiles import RailProfile, WheelProfile
+
+    f = tmp_path / "scan.png"
+    f.write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\xff\xfe")
+    with pytest.raises(DataFileError, match=re.escape(str(f)) + r": not a text profile file \(byte 0x89 at offset 0 "
+                                            r"is not UTF-8; expected two columns, lateral and vertical in mm\)"):
+        RailProfile.from_file(f) if reader == "rail" else WheelProfile.from_file(f, r0=0.46)
+    g = tmp_path / "nul.txt"
+    g.write_bytes(b"1 2\n\x00\x00\x00\n")
+    with pytest.raises(DataFileError, match=r"nul\.txt: not a text profile file \(it contains NUL bytes"):
+        RailProfile.from_file(g) if reader == "rail" else WheelProfile.from_file(g, r0=0.46)
+
+
+from railway.creep import Polach2005  # noqa: E402
+from railway.creep_curve import creep_curve  # noqa: E402
+from railway.creepage import creepages  # noqa: E402
+from railway.two_point import conical_wheel_points  # noqa: E402
+
+LIBRARY_CASES = [
+    ("creep curve without G or E",
+     lambda: creep_curve("kalker_linear", normal_force=1e5, a=6e-3, b=4e-3),
+     InputError, r"creep curve: give the shear modulus G or Young's modulus E \(both are None\), e\.g\. G=8e10"),
+    ("creep curve without semi-axes or curvatures",
+     lambda: creep_curve("kalker_linear", normal_force=1e5, G=8e10),
+     InputError, r"creep curve: give the semi-axes a and b, or the curvatures A and B with Young's modulus E "
+                 r"\(got a=None, b=None, A=None, B=None, E=None\)"),
+    ("creep curve misspelt creepage",
+     lambda: creep_curve("kalker_linear", creepage="xii", normal_force=1e5, a=6e-3, b=4e-3, G=8e10),
+     InputError, r"creep curve: creepage 'xii' is not one of \['eta', 'phi', 'xi'\]; did you mean 'xi'\?"),
+    ("creep curve values as a matrix",
+     lambda: creep_curve("kalker_linear", normal_force=1e5, a=6e-3, b=4e-3, G=8e10, values=np.zeros((2, 2))),
+     InputError, r"creep curve: values \(the swept xi\) must be a non-empty 1-D array, got shape \(2, 2\)"),
+    ("Polach k_S above k_A", lambda: Polach2005(k_A=np.float64(0.3), k_S=0.5),
+     InputError, r"Polach 2005 needs 0 < k_S <= k_A <= 1 \(reduction factors of Kalker's slope\), got k_A=0\.3, "
+                 r"k_S=0\.5$"),
+    ("Polach A above 1", lambda: Polach2005(A=1.5),
+     InputError, r"Polach 2005 friction ratio A must lie in \(0, 1\], got 1\.5 \(A = mu_inf / mu_0"),
+    ("Polach B NaN", lambda: Polach2005(B=float("nan")),
+     InputError, r"Polach 2005 friction decay B must be >= 0 s/m and finite, got nan$"),
+    ("Polach speed as text", lambda: Polach2005(speed="20 m/s"),
+     InputError, r"Polach 2005 parameter speed = '20 m/s' is not a number"),
+    ("conical wheel cone in degrees",
+     lambda: conical_wheel_points(cone=2.0),
+     InputError, r"two-point wheel: cone = 2\.0 must lie in \(0, 0\.5\)"),
+    ("creepages of a zero normal",
+     lambda: creepages(np.zeros(3), np.zeros(3), np.array([1.0, 0, 0]), np.array([0, 0, 0.46]), np.array([20.0, 0, 0]),
+         np.array([0, -20 / 0.46, 0])),
+     InputError, r"creepages: normal has zero length at contact 0"),
+]
+
+
+@pytest.mark.parametrize("call,err,pattern", [c[1:] for c in LIBRARY_CASES], ids=[c[0] for c in LIBRARY_CASES])
+def test_library_checks_raise_input_errors_naming_the_value(call, err, pattern):
+    with pytest.raises(err, match=pattern) as info:
+        call()
+    assert type(info.value) is not ValueError and isinstance(info.value, ValueError)  # old tests still hold
+    assert "np.float64" not in str(info.value) and "\n" not in str(info.value)
+
+
+def test_rigid_contact_failure_is_a_numerical_failure(monkeypatch):
+    """A shift whose iteration does not converge (forced here by one iteration) ends in a
+    NumericalFailure naming the profiles, the gauge and the shift, not a RuntimeError."""
+    from core.errors import NumericalFailure
+    from railway.contact_geometry import rigid_contact
+
+    with pytest.raises(NumericalFailure, match=r"rigid contact of wheel S1002 on rail UIC60, gauge 1435 mm: no "
+                                               r"convergence: largest gap .* m after 1 iterations at lateral shift "
+                                               r"0\.003 m"):
+        rigid_contact([0.003], max_iter=1, tol=1e-15)
+
+
+def test_rail_mounting_gauge_uses_the_range_table():
+    """One source of truth: RailMounting refuses a gauge outside the `gauge` row of
+    plausible_ranges.csv (0.6-1.7 m), with the slip named, and lets a deliberate one through."""
+    from railway.contact_geometry import contact_geometry_table
+    from railway.track import RailMounting
+
+    g = ranges()["gauge"]
+    assert (g.low, g.high) == (0.6, 1.7)
+    with pytest.raises(ImplausibleValueError, match=r"rail mounting: gauge: track gauge 1435 m is outside the "
+                                                    r"plausible range 0\.6 m \.\.\. 1\.7 m: did you mean 1435 mm\? "
+                                                    r"\(to use it deliberately, accept='gauge'\)"):
+        RailMounting(gauge=1435)
+    for gauge in (0.5, 1.8):  # inside the old 0.3-2.0 m of RailMounting, outside the table
+        with pytest.raises(ImplausibleValueError, match=rf"track gauge {gauge:g} m is outside the plausible range"):
+            RailMounting(gauge=gauge)
+        assert RailMounting(gauge=gauge, accept=["gauge"]).gauge == gauge
+    assert RailMounting(gauge=1.0).gauge == 1.0  # metre gauge
+    # the accepted gauge reaches the mounting through the table and its attrs
+    t = contact_geometry_table([0.0], gauge=1.8, flange_back_spacing=1.725, accept="gauge")
+    assert t.attrs["accept"] == ("gauge",) and t["status"].iloc[0] == "ok"
+    with pytest.raises(ImplausibleValueError, match=r"track gauge 1\.8 m"):
+        contact_geometry_table([0.0], gauge=1.8, flange_back_spacing=1.725)
+
+
+def test_accepted_gauge_of_a_vehicle_file_reaches_its_rails(tmp_path):
+    f = _write(tmp_path, ("gauge = 1.435 ", "gauge = 1.8 "), ("flange_back_spacing = 1.360", "flange_back_spacing = 1.725"))
+    with pytest.raises(ImplausibleValueError, match=r"coach\.toml \[profiles\] gauge: track gauge 1\.8 m is outside"):
+        VehicleDefinition.from_toml(f, accept=["flange_back_spacing"])
+    D = VehicleDefinition.from_toml(f, accept=["gauge", "flange_back_spacing"])
+    assert "gauge" in D.accept and D.rails().gauge == 1.8
+
+
+def test_open_track_is_not_evaluated_beyond_its_ends():
+    from core.errors import DataRangeError
+
+    tr = Track([Straight(50.0), Curve(50.0, 300.0)])
+    with pytest.raises(DataRangeError, match=r"track: evaluated at s\[1\] = 100\.5 m, beyond its end at s = 100 m: "
+                                             r"the track is open \(0 <= s <= 100 m\) and is not extrapolated"):
+        tr.evaluate([99.0, 100.5])
+    with pytest.raises(DataRangeError, match=r"track: evaluated at s\[0\] = -0\.25 m, before its start at s = 0 m"):
+        tr.evaluate(-0.25)
+    with pytest.raises(InputError, match=r"track: non-finite arc length s\[0\] = nan"):
+        tr.evaluate([np.nan])
+    # the ends themselves (and round-off past them) are on the track; internal callers extrapolate
+    assert tr.evaluate([0.0, 100.0, 100.0 + 1e-12]).position.shape == (3, 3)
+    ext = tr.evaluate([100.5], extrapolate=True)
+    np.testing.assert_allclose(ext.position, tr.evaluate_raw(np.array([100.5]))[0], atol=1e-9)
+
+
+def test_speed_control_past_the_end_of_an_open_track_names_the_end(coach):
+    """The speed control's own projection (the Python path) gives no arc length beyond the end:
+    a DataRangeError, which ends a run as failed (the compiled path returns NaN)."""
+    from types import SimpleNamespace
+
+    from core.errors import RUN_FAILURES, DataRangeError
+
+    tr = Track.straight(40.0)
+    veh = build_vehicle(coach, tr, s0=20.0, speed=20.0, speed_control=20.0)
+    kind = next(k for k in veh.model.force_kinds if type(k).__name__ == "TrackSpeedControlKind")
+    r = np.zeros((max(kind.b) + 1, 3))
+    r[kind.b[0]] = [41.5, 0.0, 1.8]
+    with pytest.raises(DataRangeError, match=r"track speed control '.*': body '.*' ran past the end of the track at "
+                                             r"s = 40 m \(s = 41\.5 m\): the track is open and is not extrapolated") as info:
+        kind._arc(SimpleNamespace(r=r), np.array([39.0]))
+    assert isinstance(info.value, RUN_FAILURES)
+    r[kind.b[0]] = [-0.5, 0.0, 1.8]
+    with pytest.raises(DataRangeError, match=r"ran off the start of the track at s = 0 m \(s = -0\.5 m\)"):
+        kind._arc(SimpleNamespace(r=r), np.array([1.0]))
+    r[kind.b[0]] = [20.0, 0.0, 1.8]
+    assert kind._arc(SimpleNamespace(r=r), np.array([20.0]))[0] == pytest.approx(20.0)

@@ -414,9 +414,10 @@ def test_unit_slips_in_the_library_name_the_value():
         WheelProfile.s1002(r0=460)
     with pytest.raises(InputError, match=r"r0 = 0.00046 m is implausible"):
         WheelProfile.s1002(r0=0.00046)
-    with pytest.raises(InputError, match=r"gauge = 1435 m is implausible.*millimetres"):
+    with pytest.raises(InputError, match=r"rail mounting: gauge: track gauge 1435 m is outside the plausible "
+                                         r"range 0\.6 m \.\.\. 1\.7 m: did you mean 1435 mm\?"):
         RailMounting(gauge=1435)
-    with pytest.raises(InputError, match=r"gauge = 0.001435 m is implausible"):
+    with pytest.raises(InputError, match=r"track gauge 0\.001435 m is outside the plausible range"):
         RailMounting(gauge=0.001435)
     with pytest.raises(InputError, match=r"flange-back spacing 1360 m is implausible"):
         ContactSearch(Track.straight(20.0), flange_back_spacing=1360)

@@ -85,14 +85,21 @@ class Bank:
         return np.asarray(self._func(np.asarray(L, dtype=float)), dtype=float)
 
     @classmethod
-    def constant(cls, theta=0.0):
-        """theta(L) = theta (rad)."""
-        th = float(theta)
+    def constant(cls, theta=0.0, accept=()):
+        """theta(L) = theta (rad; or a string with its unit, ``"30 deg"``).
+
+        A number outside the plausible bank angle (|theta| <= pi, data/coaster/plausible_ranges.csv)
+        is refused as a likely slip of degrees (:class:`core.inputs.ImplausibleValueError`);
+        ``accept=["bank_angle"]`` takes it deliberately.
+        """
+        from .inputs import check
+
+        th = float(check("bank_angle", theta, where="Bank.constant(theta)", accept=accept))
         return cls(lambda L: np.vstack([np.full(L.shape, th)] + [np.zeros(L.shape)] * 3),
                    name=f"constant {th!r} rad")
 
     @classmethod
-    def from_samples(cls, L, theta, closed=False, length=None):
+    def from_samples(cls, L, theta, closed=False, length=None, accept=()):
         """Quintic (C4) interpolating spline of theta through samples (L_i, theta_i).
 
         Parameters
@@ -103,14 +110,32 @@ class Bank:
             Periodic with period ``length`` (m); the samples must not repeat L_0 + length.
         length : float
             Period of a closed bank (the circuit length).
+        accept : sequence of str
+            ``["bank_angle"]`` accepts angles beyond +-pi (an unwrapped roll through several
+            inversions).
 
         Raises
         ------
         InputError
-            Non-finite or non-increasing samples (named by index).
+            Fewer than 6 samples (a quintic spline needs 6), samples of different lengths,
+            non-finite or non-increasing samples (named by index), a closed bank without its
+            length or with a sample at or beyond L_0 + length.
+        core.inputs.ImplausibleValueError
+            An angle beyond +-pi rad: the likely slip of degrees is named.
         """
+        from .inputs import check
+
         L = np.asarray(L, dtype=float)
-        th = np.asarray(theta, dtype=float)
+        th = theta
+        if np.ndim(L) != 1 or np.ndim(th) != 1 or len(L) != len(th):
+            raise InputError(f"bank samples: L and theta must be 1-D of equal length, got {np.shape(L)} and "
+                             f"{np.shape(th)}")
+        if len(L) < 6:
+            raise InputError(f"bank samples: a quintic bank spline needs at least 6 samples (L_i, theta_i), "
+                             f"got {len(L)}; add samples or use Bank.constant")
+        if any(isinstance(x, str) for x in th):
+            th = check("bank_angle", list(th), where="bank samples theta", accept=("bank_angle",))
+        th = np.asarray(th, dtype=float)
         for nm, a in (("L", L), ("theta", th)):
             bad = ~np.isfinite(a)
             if np.any(bad):
@@ -119,9 +144,14 @@ class Bank:
         if np.any(np.diff(L) <= 0):
             i = int(np.argmax(np.diff(L) <= 0)) + 1
             raise InputError(f"bank samples: L must increase strictly; L[{i}] = {float(L[i])!r}")
+        check("bank_angle", th, where="bank samples theta", accept=accept)
         if closed:
             if length is None:
                 raise InputError("bank samples: a closed bank needs its period 'length'")
+            if not float(length) > L[-1] - L[0]:
+                raise InputError(f"bank samples: a closed bank of period length = {float(length)!r} m needs its "
+                                 f"samples within [L_0, L_0 + length), got L from {float(L[0])!r} to "
+                                 f"{float(L[-1])!r} m (do not repeat the first sample at L_0 + length)")
             Lx = np.concatenate([L, [L[0] + float(length)]])
             tx = np.concatenate([th, th[:1]])
             b = si.make_interp_spline(Lx, tx, k=5, bc_type="periodic")

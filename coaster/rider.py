@@ -133,6 +133,10 @@ class _Rider:
     def loads(self, t, q, v):
         """(n (3,) in car axes [g], a (n_v,), v_P (3,) [m/s]) at one state."""
         a, _ = accelerations(self.model, t, q, v)
+        return self.loads_given(q, v, a)
+
+    def loads_given(self, q, v, a):
+        """As :meth:`loads` with the accelerations ``a`` (n_v,) already known."""
         qb, vb, ab = q[self.qs], v[self.vs], a[self.vs]
         A = frames.euler_to_matrix(qb[3:7])
         wb, dwb = vb[3:6], ab[3:6]

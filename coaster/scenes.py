@@ -17,6 +17,7 @@ projection, rtol = atol = 1e-8, output every 0.25 s (0.5 s with ``--fast``).
 
 from __future__ import annotations
 
+import time
 from types import SimpleNamespace
 
 import numpy as np
@@ -69,10 +70,42 @@ def _circuit_runs(fast):
     L_stop = cl.length + 0.5 * lift["L_start [m]"]       # back in the station
     dt = 0.5 if fast else 0.25
     kw = dict(method=S["method"], rtol=S["rtol"], atol=S["atol"], output_step=dt, chunk=40.0, sections=sec)
+    # warm-up: the first run of a process compiles (or loads) numba's kernels; the real-time
+    # factors below are of the runs after it, the warm-up's wall time is reported on its own
+    w0 = time.perf_counter()
+    warm = ChainLift(chain.L_start, chain.L_start + 2.0, chain.speed)
+    run_train(tr, warm.L_start, warm.speed, warm.L_end + 2.0, chain=warm,
+              forces=tr.forces(rolling=S["rolling"], drag_area=S["drag_area"], sections=sections),
+              **{**kw, "output_step": 0.5})
+    warmup = time.perf_counter() - w0
     main = run_train(tr, chain.L_start, chain.speed, L_stop, chain=chain, forces=tr.forces(sections=sections), **kw)
     lossy = run_train(tr, chain.L_start, chain.speed, L_stop, chain=chain,
                       forces=tr.forces(rolling=S["rolling"], drag_area=S["drag_area"], sections=sections), **kw)
-    return tr, fr, cl, sec, main, lossy
+    return tr, fr, cl, sec, main, lossy, warmup, (chain, sections, L_stop, kw)
+
+
+def _bank_study(fr, cl, main, setup):
+    """The circuit's bank against its turns (coaster.track.check_bank, the warning recorded) and
+    a run of the same ride on the bank designed from the main run's speed (design_bank)."""
+    import warnings
+
+    from .frames import RotationMinimisingFrame
+    from .inputs import OutwardBankWarning
+    from .track import check_bank, design_bank
+    from .train import Train, run_train
+
+    chain, sections, L_stop, kw = setup
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", OutwardBankWarning)
+        chk = check_bank(fr, main)
+    warned = [str(w.message) for w in caught if issubclass(w.category, OutwardBankWarning)]
+    bank = design_bank(cl, main)
+    fr2 = RotationMinimisingFrame(cl, bank=bank, bank_reference="vertical", max_step=2.0,
+                                  name="RMF of the circuit with the designed bank")
+    tr2 = Train(fr2, name="three-car train, designed bank")
+    run2 = run_train(tr2, chain.L_start, chain.speed, L_stop, chain=chain, forces=tr2.forces(sections=sections), **kw)
+    chk2 = check_bank(fr2, main, warn=False)
+    return chk, chk2, warned, bank, run2
 
 
 def _rider(run, car="car1"):
@@ -100,22 +133,24 @@ def _energy_drift(run, sec):
     return float(np.max(np.abs(Es - Es[0])) / T_peak), float(run.t[sel][0]), float(run.t[sel][-1]), T_peak
 
 
-def _peaks_table(loads, wf, labels, limits_table):
-    """Per section: duration, peak load factors, peak wheel forces."""
+def _peaks_table(loads, wf_peaks, labels, limits_table, peaks):
+    """Per section: duration, peak load factors and wheel forces (independent of the output step:
+    coaster.train.rider_peaks, wheel_force_peaks)."""
     rows = []
     t = loads["t [s]"].to_numpy()
+    pk = peaks.set_index("section")
+    wk = wf_peaks.set_index("section")
     for name in dict.fromkeys(labels):
         m = labels == name
         dur = float(np.sum(np.diff(t)[m[:-1]]))
-        Fb = wf.filter(regex=r"ws\d F_b").to_numpy()[m]
-        Fn = wf.filter(regex=r"ws\d F_n").to_numpy()[m]
+        p, w = pk.loc[name], wk.loc[name]
         rows.append({
             "section": name, "time in section [s]": dur,
-            "n_z max [g]": loads["n_z [g]"][m].max(), "n_z min [g]": loads["n_z [g]"][m].min(),
-            "|n_y| max [g]": loads["n_y [g]"][m].abs().max(), "n_x max [g]": loads["n_x [g]"][m].max(),
-            "n_x min [g]": loads["n_x [g]"][m].min(),
+            "n_z max [g]": p["n_z max [g]"], "n_z min [g]": p["n_z min [g]"],
+            "|n_y| max [g]": p["|n_y| max [g]"], "n_x max [g]": p["n_x max [g]"],
+            "n_x min [g]": p["n_x min [g]"],
             "|jerk_z| max [g/s]": loads["jerk_z [g/s]"][m].abs().max(),
-            "F_b max [kN]": Fb.max() / 1e3, "F_b min [kN]": Fb.min() / 1e3, "|F_n| max [kN]": np.abs(Fn).max() / 1e3,
+            "F_b max [kN]": w["F_b max [kN]"], "F_b min [kN]": w["F_b min [kN]"], "|F_n| max [kN]": w["|F_n| max [kN]"],
             "limits exceeded": ", ".join(
                 f"{r['axis']} {r['level [g]']:+g} g" for _, r in limits_table[(limits_table["section"] == name)
                                                                               & (limits_table["verdict"] == "exceeds")]
@@ -250,17 +285,32 @@ def run_coaster_circuit(ctx):
     from core.scenes import SceneResult
 
     from .rider import read_acceleration_limits, time_above_limits
-    from .train import chain_force, wheel_forces
+    from .train import chain_force, rider_peaks, wheel_force_peaks, wheel_forces
 
     fast = bool(getattr(ctx, "fast", False))
-    tr, fr, cl, sec, main, lossy = _circuit_runs(fast)
+    tr, fr, cl, sec, main, lossy, warmup, setup = _circuit_runs(fast)
     wf = wheel_forces(main)
     loads = _rider(main, "car1")
     labels = _sections_at(sec, main.L[:, 0], cl.length)
     loads.insert(2, "section", labels)
     limits = read_acceleration_limits()
     above = time_above_limits(loads, limits, sections="section")
-    peaks = _peaks_table(loads, wf, labels, above)
+    peaks = _peaks_table(loads, wheel_force_peaks(main, sec), labels, above, rider_peaks(main, "car1", sections=sec))
+    chk, chk2, warned, bank, run2 = _bank_study(fr, cl, main, setup)
+    loads2 = _rider(run2, "car1")
+    bank_rows = []
+    for name, c, ld, r in (("data (file's rolls)", chk, loads, main), ("designed from the main run's speed", chk2,
+                                                                       loads2, run2)):
+        ny = ld["n_y [g]"].to_numpy()
+        pk = rider_peaks(r, "car1").iloc[0]  # over the whole run, independent of the output step
+        bank_rows.append({"bank": name, "run status": r.status, "outward share of v2k [-]": c.outward_share,
+                          "turns banked outward": f"{c.n_outward} of {c.n_turns}",
+                          "quasi-static |n_y| RMS at the track [g]": c.lateral_rms_banked,
+                          "rider |n_y| RMS [g]": float(np.sqrt(np.mean(ny**2))),
+                          "rider |n_y| max [g]": pk["|n_y| max [g]"],
+                          "rider n_z min [g]": pk["n_z min [g]"], "rider n_z max [g]": pk["n_z max [g]"]})
+    bank_table = pd.DataFrame(bank_rows)
+    bank_turns = chk.turns
     drift, t_a, t_b, T_peak = _energy_drift(main, sec)
     tab = main.table()
     tab.insert(2, "section", labels)
@@ -268,6 +318,7 @@ def run_coaster_circuit(ctx):
         "run": name, "status": r.status, "message": r.message, "simulated [s]": float(r.t[-1]),
         "L1 reached [m]": float(np.max(r.L[:, 0])), "integration wall [s]": r.wall_time,
         "real-time factor": r.real_time_factor, "method": r.meta["method"], "rtol": r.meta["rtol"],
+        "compilation + warm-up wall [s]": warmup if name.startswith("no") else 0.0,
     } for name, r in (("no rolling resistance or drag", main), ("rolling resistance + drag", lossy))])
     energy = pd.DataFrame([{"section": "free running, lift end to booster", "t from [s]": t_a, "t to [s]": t_b,
                             "max|E - E0| / T_peak": drift, "T_peak [J]": T_peak}])
@@ -289,21 +340,30 @@ def run_coaster_circuit(ctx):
         f"chain_force), booster on Launch to {CIRCUIT_SETTINGS['booster_speed']} m/s, brakes on Brake to "
         f"{CIRCUIT_SETTINGS['brake_speed']} m/s. Main run: {main.status} ({main.message}); simulated "
         f"{main.t[-1]:.1f} s in {main.wall_time:.1f} s of integration (real-time factor "
-        f"{main.real_time_factor:.1f}). Energy drift over the free-running section without dissipation: "
+        f"{main.real_time_factor:.1f}, after a warm-up run that compiled the kernels in {warmup:.1f} s). "
+        f"Peak load factors and wheel forces per section from the outputs, the section boundaries and re-integrated "
+        f"states around each extreme (coaster.train.rider_peaks, wheel_force_peaks: independent of the output step). "
+        f"Energy drift over the free-running section without dissipation: "
         f"{drift:.2e} of the peak kinetic energy. With rolling resistance c_rr = {CIRCUIT_SETTINGS['rolling']} and "
         f"c_d A = {CIRCUIT_SETTINGS['drag_area']} m^2: {lossy.status} ({lossy.message}). "
         f"Rider loads at the rider point of car 1 {tr.p.rider_point} m (coaster.rider); limits from "
         f"{limits['basis'].iloc[0] if 'basis' in limits else 'data/coaster/acceleration_limits.csv'}. "
         f"The station rows of the data carry 40-55 deg rolls (kept as given). Track: quintic periodic spline "
         f"through the 203 control points, rotation-minimising frame with the file's rolls relative to the "
-        f"vertical (coaster.frames)."
+        f"vertical (coaster.frames). Bank check (coaster.track.check_bank, weighted by v^2 kappa with the main run's "
+        f"speed): {100 * chk.outward_share:.0f} % of the lateral demand is on outward bank ({chk.n_outward} of "
+        f"{chk.n_turns} turns)" + (f"; OutwardBankWarning: {warned[0]}" if warned else "") + ". With the bank designed "
+        f"from the run's speed (coaster.track.design_bank, roll = atan(v^2 kappa / g)) the rider's |n_y| RMS is "
+        f"{bank_rows[1]['rider |n_y| RMS [g]']:.3g} g against {bank_rows[0]['rider |n_y| RMS [g]']:.3g} g "
+        f"(table bank_design)."
     )
     return SceneResult(
         tables={"runs": runs, "energy_drift": energy, "section_peaks": peaks, "time_above_limits": above,
                 "rank_along_circuit": rank_summary, "speed": tab.iloc[::every].reset_index(drop=True),
                 "wheel_forces": wf.iloc[::every].reset_index(drop=True), "rider_loads": loads.iloc[::every]
                 .reset_index(drop=True), "chain_force": chain_force(main).iloc[::every].reset_index(drop=True),
-                "sections": sec, "frame_quality_summary": fq_summary,
+                "sections": sec, "frame_quality_summary": fq_summary, "bank_design": bank_table,
+                "bank_turns": bank_turns,
                 "frame_quality": fq.iloc[::10 if not fast else 2].reset_index(drop=True)},
         figures=figs, notes=notes)
 

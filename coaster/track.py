@@ -150,6 +150,33 @@ class Centreline(abc.ABC):
 _SPLINE_KINDS = ("cubic", "quintic", "pchip", "akima", "makima")
 
 
+def _check_spacing(name, chords, closed, accept=()):
+    """Plausible control-point spacing and, on a closed track, a closing chord that is not a gap.
+
+    The typical spacing is the median chord |P_j+1 - P_j| (a coordinate slip, mm or km for m,
+    moves it out of ``control_point_spacing`` in data/coaster/plausible_ranges.csv).  A closed
+    track adds the chord from the last point back to the first; when that chord is longer than
+    twice the median and longer than every other chord, the points do not describe a closed
+    track (the spline would bridge the gap silently): refused with the gap, the typical chord
+    and how to declare the track open.
+    """
+    from .inputs import check
+
+    inner = chords[:-1] if closed else chords
+    med = float(np.median(inner)) if inner.size else float(chords[0])
+    check("control_point_spacing", med, where=f"{name}: control points",
+          accept=accept)
+    if closed and inner.size and "closure_gap" not in set(accept):
+        gap = float(chords[-1])
+        if gap > 2.0 * med and gap > float(np.max(inner)):
+            raise InputError(
+                f"{name}: closed=True, but the last control point is {gap:.4g} m from the first, "
+                f"{gap / med:.2g} times the typical chord {med:.4g} m (median; longest other chord "
+                f"{float(np.max(inner)):.4g} m): the points do not close the track and the spline would "
+                f"bridge the gap; add the missing control points, or declare the track open (closed=False); "
+                f"to bridge it deliberately, accept=['closure_gap']")
+
+
 class SplineCentreline(Centreline):
     """Interpolating spline through control points, reparameterised by arc length.
 
@@ -205,6 +232,10 @@ class SplineCentreline(Centreline):
     n_gauss : int
         Gauss-Legendre points per span for the arc length.
     name : str
+    accept : sequence of str
+        Checks not to enforce: ``"control_point_spacing"`` (a median chord outside the plausible
+        range of data/coaster/plausible_ranges.csv), ``"closure_gap"`` (a closed track whose
+        closing chord is a gap).
 
     Attributes
     ----------
@@ -220,7 +251,11 @@ class SplineCentreline(Centreline):
     ------
     InputError
         Fewer than 4 points, a non-finite coordinate, two equal points, consecutive or not
-        (the message names both indices), an unknown kind or end condition.
+        (the message names both indices), an unknown kind or end condition, a closed track
+        whose closing chord is a gap (longer than twice the median chord and than every other
+        chord: names the gap and the typical chord).
+    core.inputs.ImplausibleValueError
+        A median chord outside the plausible control-point spacing (coordinates in mm or km).
 
     References
     ----------
@@ -229,7 +264,7 @@ class SplineCentreline(Centreline):
     """
 
     def __init__(self, points, kind="cubic", closed=False, bc="not-a-knot", n_gauss=8,
-                 name="spline centreline"):
+                 name="spline centreline", accept=()):
         self.name = str(name)
         if kind not in _SPLINE_KINDS:
             raise InputError(f"{self.name}: unknown spline kind {kind!r}; use one of {_SPLINE_KINDS}")
@@ -254,6 +289,7 @@ class SplineCentreline(Centreline):
             j = (i + 1) % P.shape[0]
             raise InputError(f"{self.name}: control points {i} and {j} coincide ({P[i].tolist()}); "
                              f"consecutive points must differ")
+        _check_spacing(self.name, chords, closed, accept)
         self.points = P
         self.kind = kind
         self.closed = bool(closed)
@@ -806,6 +842,9 @@ def check_clearance(centreline: Centreline, clearance, spacing=None, raise_error
     c = float(clearance)
     if not (np.isfinite(c) and c > 0):
         raise InputError(f"{name}: clearance must be positive and finite (m), got {clearance!r}")
+    from .inputs import check
+
+    c = float(check("clearance", c, where=f"{name}: check_clearance(clearance=...)"))
     h = c / 4.0 if spacing is None else float(spacing)
     if not (np.isfinite(h) and h > 0):
         raise InputError(f"{name}: spacing must be positive and finite (m), got {spacing!r}")
@@ -883,7 +922,7 @@ class CircuitData:
 _COLUMNS = ["idx", "x", "y", "z", "roll_deg", "section", "terrain_z"]
 
 
-def read_circuit(path=None) -> CircuitData:
+def read_circuit(path=None, accept=()) -> CircuitData:
     """Read a coaster-sim track CSV (Unreal Engine units) into SI, right-handed axes.
 
     The file has columns ``idx,x,y,z,roll_deg,section,terrain_z`` in centimetres and degrees in
@@ -898,6 +937,8 @@ def read_circuit(path=None) -> CircuitData:
     ----------
     path : str or Path, optional
         Default :data:`CIRCUIT_FILE`.
+    accept : sequence of str
+        ``["control_point_spacing"]`` accepts a median point spacing outside the plausible range.
 
     Returns
     -------
@@ -908,7 +949,9 @@ def read_circuit(path=None) -> CircuitData:
     DataFileError
         Missing file, wrong header, a row with the wrong number of fields, a non-numeric or
         non-finite value, or ``idx`` not counting 0, 1, 2, ... (the message names the file,
-        the data row and its line).
+        the data row and its line); a median point spacing outside the plausible control-point
+        spacing (a file written in metres or millimetres instead of centimetres: the message
+        names the likely unit).
     """
     path = Path(CIRCUIT_FILE if path is None else path)
     if not path.is_file():
@@ -941,6 +984,15 @@ def read_circuit(path=None) -> CircuitData:
             sec.append(row[5].strip())
     if len(idx) < 4:
         raise DataFileError(f"{path}: only {len(idx)} data rows, need at least 4")
+    from .inputs import check
+
+    P = np.array(pts)
+    med_cm = 100.0 * float(np.median(np.linalg.norm(np.diff(P, axis=0), axis=1)))
+    try:
+        check("control_point_spacing", med_cm, unit="cm", accept=accept,
+              where=f"{path}: columns x, y, z (centimetres by the format; median spacing of the points)")
+    except InputError as exc:
+        raise DataFileError(str(exc)) from None
     return CircuitData(np.array(pts), np.array(roll), np.array(sec), np.array(idx), path)
 
 
@@ -961,3 +1013,313 @@ def circuit_centreline(data: CircuitData | None = None, kind="quintic", n_gauss=
     data = read_circuit() if data is None else data
     return SplineCentreline(data.points, kind=kind, closed=True, n_gauss=n_gauss,
                             name=f"circuit {data.path.name} ({kind})")
+
+
+# ---------------------------------------------------------------------------------------------
+# bank: check against the turns, design from the speed
+# ---------------------------------------------------------------------------------------------
+_EZ = np.array([0.0, 0.0, 1.0])
+#: g used by the bank check and design when none is given (m/s²; coaster.train.G)
+G_BANK = 9.81
+
+
+def _vertical_frame(g1):
+    """Horizontal lateral n_v = e_z x t/|e_z x t| (left) and v_v = t x n_v (up) at tangents g1 (N, 3)."""
+    nv = np.cross(_EZ, g1)
+    s = np.linalg.norm(nv, axis=1)
+    if np.any(s < 1e-9):
+        i = int(np.argmin(s))
+        raise InputError(f"bank: the lateral direction is undefined on vertical track (sample {i})")
+    nv /= s[:, None]
+    return nv, np.cross(g1, nv)
+
+
+def speed_from_energy(centreline: Centreline, L0: float, v0: float, gravity: float = G_BANK):
+    """Speed along the track of a frictionless train released at ``L0`` with speed ``v0``.
+
+    v(L) = sqrt(max(0, v0^2 + 2 g (z(L0) - z(L))))  (energy of a point mass on the centreline;
+    0 where the train cannot get).  Returns a callable ``v(L)`` (m/s) for :func:`design_bank` and
+    :func:`check_bank`.
+    """
+    L0, v0, gravity = float(L0), float(v0), float(gravity)
+    z0 = float(centreline.derivatives([L0])[0, 0, 2])
+
+    def v(L):
+        z = centreline.derivatives(np.asarray(L, float))[0][:, 2]
+        return np.sqrt(np.maximum(0.0, v0**2 + 2.0 * gravity * (z0 - z)))
+
+    v.description = f"energy speed from v = {v0:g} m/s at L = {L0:g} m"
+    return v
+
+
+def _speed_samples(speed, L, centreline, where):
+    """The speed (m/s) at arc lengths L from: None (1 everywhere: geometry only), a number, a
+    callable v(L), an (L_i, v_i) pair of arrays, or a run with ``L`` and ``Ldot`` (lead wheelset)."""
+    if speed is None:
+        return np.ones_like(L)
+    if callable(speed):
+        v = np.asarray(speed(L), float).reshape(-1)
+    elif hasattr(speed, "L") and hasattr(speed, "Ldot"):
+        Ls = np.asarray(speed.L, float)[:, 0]
+        vs = np.asarray(speed.Ldot, float)[:, 0]
+        if centreline.closed:  # the first lap only (a later pass at another speed would interleave)
+            first = Ls < Ls[0] + centreline.length
+            Ls, vs = Ls[first], vs[first]
+        v = _interp_speed(Ls, vs, L, centreline, where)
+    elif isinstance(speed, tuple) and len(speed) == 2:
+        v = _interp_speed(np.asarray(speed[0], float).reshape(-1), np.asarray(speed[1], float).reshape(-1), L,
+                          centreline, where)
+    else:
+        from .inputs import check
+
+        v = np.full(L.shape, float(check("track_speed", speed, where=f"{where}(speed=...)")))
+    if v.shape != L.shape or not np.all(np.isfinite(v)):
+        raise InputError(f"{where}: the speed must give one finite value per arc length (got shape {v.shape})")
+    return np.abs(v)
+
+
+def _interp_speed(Ls, vs, L, centreline, where):
+    if Ls.shape != vs.shape or Ls.size < 2:
+        raise InputError(f"{where}: speed samples (L_i, v_i) must be two arrays of equal length >= 2")
+    length = float(centreline.length)
+    if centreline.closed:
+        Ls = np.mod(Ls, length)
+    order = np.argsort(Ls, kind="stable")
+    Ls, vs = Ls[order], vs[order]
+    keep = np.concatenate([[True], np.diff(Ls) > 0])
+    Ls, vs = Ls[keep], vs[keep]
+    gaps = np.diff(np.concatenate([Ls, [Ls[0] + length]])) if centreline.closed else np.diff(Ls)
+    ends = (Ls[0], length - Ls[-1]) if not centreline.closed else (0.0, 0.0)
+    worst = max(float(np.max(gaps)), *ends)
+    if worst > max(20.0, 0.1 * length):  # a few output steps or a station stop are bridged linearly
+        raise InputError(f"{where}: the speed samples cover L = {Ls[0]:.6g} ... {Ls[-1]:.6g} m of the "
+                         f"{length:.6g} m track with a gap of {worst:.4g} m: run over the whole track, or give "
+                         f"the speed as a function (e.g. coaster.track.speed_from_energy)")
+    if centreline.closed:
+        return np.interp(np.mod(L, length), Ls, vs, period=length)
+    return np.interp(L, Ls, vs)
+
+
+def _samples(centreline, step):
+    n = max(8, int(math.ceil(centreline.length / float(step))))
+    return np.linspace(0.0, centreline.length, n, endpoint=not centreline.closed)
+
+
+class BankCheck(NamedTuple):
+    """Result of :func:`check_bank` (numbers measured on samples every ``step`` m).
+
+    Attributes
+    ----------
+    outward_share : float
+        Share of the lateral demand sum |v^2 kappa_h| carried where the bank tilts the riders
+        outward (0: every turn banked inward; 1: every turn banked outward).
+    n_turns, n_outward : int
+        Turns (runs of one sign of kappa_h whose peak demand exceeds ``turn_level``) and those
+        banked outward over most of their demand.
+    lateral_rms_banked, lateral_rms_flat : float
+        RMS of the quasi-static lateral load factor at the track f.n/g with the track's bank and
+        with flat track (g), over the samples.
+    lateral_max_banked, lateral_max_flat : float
+        Largest |f.n|/g with the bank and flat (g).
+    turns : pandas.DataFrame
+        One row per turn: ``L_start [m]``, ``L_end [m]``, ``direction``, ``peak v2k/g [g]``,
+        ``mean bank [deg]``, ``outward share [-]``, ``banked``.
+    """
+
+    outward_share: float
+    n_turns: int
+    n_outward: int
+    lateral_rms_banked: float
+    lateral_rms_flat: float
+    lateral_max_banked: float
+    lateral_max_flat: float
+    turns: object
+
+
+def check_bank(frame, speed=None, *, step=1.0, gravity=G_BANK, turn_level=0.1, min_bank=math.radians(2.0),
+               warn=True) -> BankCheck:
+    r"""Compare the sign of a track's bank with the sign of its turns, weighted by v^2 kappa.
+
+    At samples every ``step`` m: t = g', the horizontal lateral n_v = e_z x t/|e_z x t| (left),
+    v_v = t x n_v, the signed lateral curvature kappa_h = g''.n_v (> 0 turning left), the bank
+    relative to the vertical phi = atan2(-b.n_v, b.v_v) of the frame's up axis b (> 0 rolls the
+    up axis to the right, the convention of :func:`read_circuit`).  A bank tilts the riders
+    *into* the turn when b leans towards the centre of curvature (phi kappa_h < 0) and *out of*
+    it when phi kappa_h > 0.  Weights w = v^2 |kappa_h| (the lateral demand of flat track; with
+    ``speed=None`` the curvature alone)::
+
+        outward share = sum w [phi kappa_h > 0, |phi| > min_bank] / sum w
+
+    The quasi-static lateral load factor at the track (no roll-rate terms, the rider on the
+    centreline) is n_y = f.n/g with f = v^2 g'' + g e_z (the tangential part drops out), flat
+    track n = n_v.
+
+    Parameters
+    ----------
+    frame : core.curves.FramedCurve
+        A framed track with a ``centreline`` (e.g. :class:`coaster.frames.RotationMinimisingFrame`).
+    speed : None, float, callable, (L, v) arrays or a TrainRun
+        Speed along the track (m/s): a run's lead speed, :func:`speed_from_energy`, or a constant.
+    step : float
+        Sample spacing (m).
+    turn_level : float
+        A turn is a run of one sign of kappa_h whose peak v^2 kappa_h/g exceeds this (g; with
+        ``speed=None`` the threshold is on kappa_h in 1/m divided by 100).
+    min_bank : float
+        Banks smaller than this (rad) count as flat.
+    warn : bool
+        Issue :class:`coaster.inputs.OutwardBankWarning` when the outward share exceeds 1/2.
+
+    Returns
+    -------
+    BankCheck
+
+    Warns
+    -----
+    coaster.inputs.OutwardBankWarning
+        Most of the lateral demand is on outward banking (the message gives the share, the turns
+        and the RMS lateral loads with the bank and flat, and points to :func:`design_bank`).
+    """
+    import warnings
+
+    import pandas as pd
+
+    from .inputs import OutwardBankWarning
+
+    cl = getattr(frame, "centreline", None)
+    if cl is None:
+        raise InputError(f"check_bank: {getattr(frame, 'name', frame)!r} has no centreline (give a framed track such "
+                         f"as a RotationMinimisingFrame)")
+    L = _samples(cl, step)
+    d = cl.derivatives(L)
+    v = _speed_samples(speed, L, cl, "check_bank")
+    R = frame.evaluate(L).R
+    nv, vv = _vertical_frame(d[1])
+    b, n = R[:, :, 2], R[:, :, 1]
+    phi = np.arctan2(-np.einsum("ij,ij->i", b, nv), np.einsum("ij,ij->i", b, vv))
+    kh = np.einsum("ij,ij->i", d[2], nv)
+    w = v**2 * np.abs(kh)
+    outward = (phi * kh > 0) & (np.abs(phi) > min_bank)
+    total = float(np.sum(w))
+    share = float(np.sum(w[outward]) / total) if total > 0 else 0.0
+    f = v[:, None] ** 2 * d[2] + gravity * _EZ
+    ny_b = np.einsum("ij,ij->i", f, n) / gravity
+    ny_f = np.einsum("ij,ij->i", f, nv) / gravity
+    level = turn_level if speed is not None else turn_level / 100.0
+    demand = w / gravity if speed is not None else np.abs(kh)
+    rows = []
+    sgn = np.sign(kh)
+    i = 0
+    while i < L.size:
+        j = i
+        while j + 1 < L.size and sgn[j + 1] == sgn[i]:
+            j += 1
+        if sgn[i] != 0 and float(np.max(demand[i:j + 1])) > level:
+            ws = w[i:j + 1]
+            out = float(np.sum(ws[outward[i:j + 1]]) / max(float(np.sum(ws)), 1e-300))
+            rows.append({"L_start [m]": float(L[i]), "L_end [m]": float(L[j]),
+                         "direction": "left" if sgn[i] > 0 else "right",
+                         "peak v2k/g [g]": float(np.max(w[i:j + 1]) / gravity) if speed is not None else np.nan,
+                         "mean bank [deg]": float(np.degrees(np.average(phi[i:j + 1], weights=ws + 1e-300))),
+                         "outward share [-]": out, "banked": "outward" if out > 0.5 else "inward or flat"})
+        i = j + 1
+    turns = pd.DataFrame(rows, columns=["L_start [m]", "L_end [m]", "direction", "peak v2k/g [g]", "mean bank [deg]",
+                                        "outward share [-]", "banked"])
+    n_out = int(np.sum(turns["banked"] == "outward")) if len(turns) else 0
+    res = BankCheck(share, len(turns), n_out, float(np.sqrt(np.mean(ny_b**2))), float(np.sqrt(np.mean(ny_f**2))),
+                    float(np.max(np.abs(ny_b))), float(np.max(np.abs(ny_f))), turns)
+    if warn and share > 0.5:
+        name = getattr(frame, "name", "track")
+        warnings.warn(OutwardBankWarning(
+            f"{name}: the bank tilts the riders out of the turns for {100 * share:.0f} % of the lateral demand "
+            f"v^2 kappa ({n_out} of {len(turns)} turns banked outward); quasi-static lateral load at the track RMS "
+            f"{res.lateral_rms_banked:.3g} g (max {res.lateral_max_banked:.3g} g) with this bank against "
+            f"{res.lateral_rms_flat:.3g} g (max {res.lateral_max_flat:.3g} g) on flat track: is the roll sign flipped "
+            f"(left-handed data)? coaster.track.design_bank designs a bank from the speed"), stacklevel=2)
+    return res
+
+
+def design_bank(centreline: Centreline, speed, *, step=2.0, gravity=G_BANK, min_vertical=1.0, smooth=10.0, name=None):
+    r"""A bank (roll relative to the vertical) that cancels the quasi-static lateral load.
+
+    The coaster designer's rule, roll = atan(v^2 kappa / g), in the general form for a track
+    with grade and vertical curvature: the specific force on a rider moving at speed v on the
+    centreline is f = a - g_vec = v' t + v^2 g'' + g e_z; its part normal to the track,
+    f_perp = v^2 g'' + g (e_z - (e_z.t) t), lies in the plane of the up axis b and the lateral
+    axis n; the lateral load f.n vanishes when b is parallel to f_perp.  With the horizontal
+    lateral n_v = e_z x t/|e_z x t| and v_v = t x n_v (f_perp.n_v = v^2 kappa_h,
+    f_perp.v_v = v^2 kappa_v + g cos(gamma), kappa_h = g''.n_v, kappa_v = g''.v_v, gamma the
+    grade)::
+
+        phi(L) = atan2(-v^2 kappa_h, max(v^2 kappa_v + g cos(gamma), min_vertical g))
+
+    (positive phi rolls the up axis to the right, as :func:`read_circuit`; on a level turn
+    phi = -atan(v^2 kappa_h/g), the rider tilted into the turn by tan(beta) = v^2/(g R)).  The
+    floor ``min_vertical`` (default 1 g: the designer's atan(v^2 kappa / g) over crests) keeps
+    the bank moderate where the vertical load falls towards zero: on the circuit, a crest taken
+    at 36 m/s with -0.2 g in a 530 m bend would otherwise get 51 deg of bank within 20 m (with a
+    floor of 0.2 g the rider's lateral load spiked to 12 g from the roll acceleration).  The
+    samples are then averaged over ``smooth`` m (centred moving average, a designer's roll
+    spiral that bounds the roll acceleration v^2 phi'').  The design is on the track centreline
+    (the rider's heartline taken as the centreline: a rider h above the track in a turn of
+    radius R keeps a lateral load of order q h/R, q = v^2/(g R)).
+
+    Parameters
+    ----------
+    centreline : Centreline
+    speed : float, callable, (L, v) arrays or a TrainRun
+        Speed along the track (m/s): a run's lead speed (the run must cover the track), a
+        callable v(L) such as :func:`speed_from_energy`, or a constant.
+    step : float
+        Spacing of the bank samples (m); the bank is the quintic spline through them
+        (:meth:`coaster.frames.Bank.from_samples`, periodic on a closed track).
+    gravity : float
+        g (m/s²).
+    min_vertical : float
+        Floor of the vertical load factor in the rule (g), 0 < min_vertical <= 1.
+    smooth : float
+        Length of the moving average of the bank samples (m); 0 for none.
+
+    Returns
+    -------
+    coaster.frames.Bank
+        phi(L) relative to the vertical: use it as
+        ``RotationMinimisingFrame(centreline, bank=b, bank_reference="vertical")``.  Its
+        ``samples`` attribute holds the (L, phi) samples.
+
+    References
+    ----------
+    notes/coaster.md "Closed forms": banked horizontal circle, tan(beta) = q is the perfect bank.
+    """
+    from .frames import Bank
+
+    if speed is None:
+        raise InputError("design_bank: a speed is needed (a run, speed_from_energy(...), or a number in m/s)")
+    if not (0.0 < float(min_vertical) <= 1.0):
+        raise InputError(f"design_bank: min_vertical must be in (0, 1] g, got {min_vertical!r}")
+    if not (np.isfinite(smooth) and smooth >= 0):
+        raise InputError(f"design_bank: smooth must be a length >= 0 (m), got {smooth!r}")
+    L = _samples(centreline, step)
+    d = centreline.derivatives(L)
+    v = _speed_samples(speed, L, centreline, "design_bank")
+    nv, vv = _vertical_frame(d[1])
+    kh = np.einsum("ij,ij->i", d[2], nv)
+    kv = np.einsum("ij,ij->i", d[2], vv)
+    cos_grade = np.linalg.norm(np.cross(_EZ, d[1]), axis=1)
+    den = np.maximum(v**2 * kv + gravity * cos_grade, float(min_vertical) * gravity)
+    phi = np.arctan2(-(v**2) * kh, den)
+    if smooth > 0:  # centred moving average over `smooth` metres (periodic on a closed track)
+        m = max(1, int(round(float(smooth) / (L[1] - L[0]))))
+        if m > 1:
+            k = np.ones(m) / m
+            if centreline.closed:
+                ext = np.concatenate([phi[-m:], phi, phi[:m]])
+                phi = np.convolve(ext, k, mode="same")[m:-m]
+            else:
+                ext = np.concatenate([np.full(m, phi[0]), phi, np.full(m, phi[-1])])
+                phi = np.convolve(ext, k, mode="same")[m:-m]
+    bank = Bank.from_samples(L, phi, closed=centreline.closed, length=centreline.length if centreline.closed else None)
+    bank.name = name or f"designed bank of {centreline.name} (roll = atan(v^2 kappa / g))"
+    bank.samples = (L, phi)
+    bank.reference = "vertical"
+    return bank

@@ -123,6 +123,9 @@ __all__ = [
     "TrainRun",
     "run_train",
     "wheel_forces",
+    "rider_peaks",
+    "section_extremes",
+    "wheel_force_peaks",
     "rank_table",
     "circuit_frame",
     "circuit_sections",
@@ -135,11 +138,41 @@ G = 9.81
 # ---------------------------------------------------------------------------------------------
 # parameters
 # ---------------------------------------------------------------------------------------------
+def _to_si(obj, fields: dict, who: str):
+    """Convert ``obj``'s fields (name -> range quantity) given as strings with units to SI floats
+    (frozen dataclass: object.__setattr__); numbers pass unchanged."""
+    from core.inputs import parse_quantity
+
+    from .inputs import ranges
+
+    for f, quantity in fields.items():
+        x = getattr(obj, f)
+        if isinstance(x, str):
+            object.__setattr__(obj, f, float(parse_quantity(x, ranges()[quantity].unit, where=f"{who} {f}")))
+
+
+def _accept_tuple(obj):
+    acc = (obj.accept,) if isinstance(obj.accept, str) else tuple(obj.accept)
+    object.__setattr__(obj, "accept", acc)
+    return acc
+
+
+#: physical fields of TrainParameters -> vector length (None: a scalar); each has a plausible range
+_PARAM_FIELDS = {"car_mass": None, "car_inertia": 3, "wheelset_mass": None, "wheelset_inertia": 3, "bar_mass": None,
+                 "bar_inertia": 3, "pivot_spacing": None, "pivot_height": None, "cg_height": None,
+                 "coupler_overhang": None, "bar_length": None, "rider_point": 3, "wheel_spin_mass": None,
+                 "rider_mass": None}
+
+
 @dataclass(frozen=True)
 class TrainParameters:
     """Geometry and inertia of the train (SI units; body axes x forward, y left, z up).
 
     Representative values of a steel coaster train, not those of Pombo & Ambrósio (2007).
+    Every physical field takes a number in SI units or a string with its unit (``"0.9 t"``,
+    ``"1800 mm"``) and is checked against its plausible range (data/coaster/plausible_ranges.csv,
+    :mod:`coaster.inputs`): ``car_mass=0.9`` is refused with "did you mean 0.9 t?", unless
+    ``accept=("car_mass",)``.
 
     Attributes
     ----------
@@ -165,6 +198,12 @@ class TrainParameters:
         l_b: distance between the bar's two joints (m).
     rider_point : (3,) tuple
         A rider's position in car axes relative to the car's centre of mass (m).
+    rider_mass : float
+        Mass of one rider (kg); with ``riders_per_car`` a consistency check only: ``car_mass``
+        includes the riders and must exceed ``riders_per_car * rider_mass``.
+    riders_per_car : int
+    accept : tuple of str
+        Quantities whose plausible range (data/coaster/plausible_ranges.csv) is not enforced.
     wheel_spin_mass : float
         Equivalent mass of the spinning wheels of one wheelset on its arc length, Σ J_w/r_w²
         (kg; two road wheels of 0.1 kg m² on r_w = 0.2 m give 5 kg).  The wheelset body is locked to
@@ -189,8 +228,31 @@ class TrainParameters:
     bar_length: float = 0.8
     rider_point: tuple = (0.0, 0.0, 0.4)
     wheel_spin_mass: float = 5.0
+    rider_mass: float = 75.0
+    riders_per_car: int = 4
+    accept: tuple = ()
 
     def __post_init__(self):
+        from core.inputs import parse_quantity
+
+        from .inputs import check, ranges
+
+        acc = (self.accept,) if isinstance(self.accept, str) else tuple(self.accept)
+        object.__setattr__(self, "accept", acc)
+        R = ranges()
+        for f, n in _PARAM_FIELDS.items():  # units first (a string such as "0.9 t"), SI floats after
+            x = getattr(self, f)
+            v = parse_quantity(x, R[f].unit, where=f"TrainParameters {f}")
+            if n is None:
+                if np.ndim(v) != 0:
+                    raise InputError(f"TrainParameters {f}: must be one number, got {x!r}")
+                v = float(v)
+            else:
+                v = np.atleast_1d(v)
+                if v.size != n:
+                    raise InputError(f"TrainParameters {f}: must be {n} numbers, got {x!r}")
+                v = tuple(float(a) for a in v)
+            object.__setattr__(self, f, v)
         if int(self.n_cars) != self.n_cars or self.n_cars < 1:
             raise InputError(f"TrainParameters: n_cars must be a positive integer, got {self.n_cars!r}")
         for name in ("car_mass", "wheelset_mass", "bar_mass", "pivot_spacing", "bar_length"):
@@ -205,6 +267,45 @@ class TrainParameters:
                 raise InputError(f"TrainParameters: {name} must be finite, got {x!r}")
         if self.coupler_overhang < 0:
             raise InputError(f"TrainParameters: coupler_overhang must be >= 0, got {self.coupler_overhang!r}")
+        if isinstance(self.riders_per_car, bool) or int(self.riders_per_car) != self.riders_per_car:
+            raise InputError(f"TrainParameters: riders_per_car must be a whole number, got {self.riders_per_car!r}")
+        for f in _PARAM_FIELDS:
+            check(f, getattr(self, f), where=f"TrainParameters {f}", accept=acc)
+        check("riders_per_car", self.riders_per_car, where="TrainParameters riders_per_car", accept=acc)
+        riders = self.riders_per_car * self.rider_mass
+        if riders >= self.car_mass and "car_mass" not in acc:
+            raise InputError(f"TrainParameters: car_mass {self.car_mass:g} kg is the car *with* its riders, but its "
+                             f"{self.riders_per_car} riders of {self.rider_mass:g} kg weigh {riders:g} kg alone: is "
+                             f"car_mass the empty car (add the riders), or rider_mass per car instead of per rider?")
+
+    @classmethod
+    def from_dict(cls, data: dict, source: str = "train parameters", accept=()) -> "TrainParameters":
+        """Train parameters from a mapping (a table read from a file, keyword options).
+
+        Unknown keys are refused with the closest valid one named
+        (:class:`core.errors.UnknownOptionError`: ``car_mas: unknown option; did you mean
+        'car_mass'?``); values are numbers in SI units or strings with their unit; an ``accept``
+        entry in the mapping (a list of quantities) adds to ``accept``.
+        """
+        from dataclasses import fields as _fields
+
+        from core.inputs import check_keywords
+
+        if not isinstance(data, dict):
+            raise InputError(f"{source}: train parameters must be a mapping of names to values, got "
+                             f"{type(data).__name__}")
+        names = [f.name for f in _fields(cls)]
+        check_keywords(data.keys(), names, where=source)
+        data = dict(data)
+        acc = tuple(accept) + tuple(data.pop("accept", ()))
+        try:
+            return cls(**data, accept=acc)
+        except InputError as exc:
+            from core.inputs import ImplausibleValueError
+
+            if isinstance(exc, ImplausibleValueError):
+                raise ImplausibleValueError(f"{source}: {exc}", exc.quantity, exc.value, exc.suggestion) from None
+            raise type(exc)(f"{source}: {exc}") from None
 
     @property
     def n_wheelsets(self) -> int:
@@ -248,6 +349,9 @@ class SpeedSection:
     mode : {"brake", "booster"}
     ramp : float
         Length of the window's smooth ends (m).
+    accept : tuple of str
+        Quantities whose plausible range is not enforced (``track_speed``, ``section_force``,
+        ``section_gain``, ``section_ramp``); numbers are SI, strings carry their unit ("80 km/h").
     """
 
     name: str
@@ -258,9 +362,15 @@ class SpeedSection:
     gain: float = 2.0e4
     mode: str = "brake"
     ramp: float = 2.0
+    accept: tuple = ()
 
     def __post_init__(self):
         who = f"speed section {self.name!r}"
+        from .inputs import check
+
+        acc = _accept_tuple(self)
+        _to_si(self, {"L_start": "section_ramp", "L_end": "section_ramp", "target_speed": "track_speed",
+                      "max_force": "section_force", "gain": "section_gain", "ramp": "section_ramp"}, who)
         if self.mode not in ("brake", "booster"):
             raise InputError(f"{who}: mode must be 'brake' or 'booster', got {self.mode!r}")
         if not (np.isfinite(self.L_start) and np.isfinite(self.L_end) and self.L_end > self.L_start):
@@ -272,6 +382,10 @@ class SpeedSection:
         if 2 * self.ramp > self.L_end - self.L_start:
             raise InputError(f"{who}: ramp {self.ramp!r} m is longer than half the section "
                              f"({self.L_end - self.L_start:.3g} m)")
+        check("track_speed", self.target_speed, where=f"{who} target_speed", accept=acc)
+        check("section_force", self.max_force, where=f"{who} max_force", accept=acc)
+        check("section_gain", self.gain, where=f"{who} gain", accept=acc)
+        check("section_ramp", self.ramp, where=f"{who} ramp", accept=acc)
 
     @property
     def sign(self) -> float:
@@ -280,17 +394,27 @@ class SpeedSection:
 
 @dataclass(frozen=True)
 class ChainLift:
-    """Chain lift: the lead wheelset driven at constant ``speed`` (m/s) from ``L_start`` to ``L_end`` (m)."""
+    """Chain lift: the lead wheelset driven at constant ``speed`` (m/s) from ``L_start`` to ``L_end`` (m).
+
+    ``speed`` is checked against the plausible chain speed (0.1-12 m/s; "30" meant as km/h is
+    refused with "did you mean 30 km/h?"); ``accept=("chain_speed",)`` takes an outlier.
+    """
 
     L_start: float
     L_end: float
     speed: float
+    accept: tuple = ()
 
     def __post_init__(self):
+        from .inputs import check
+
+        acc = _accept_tuple(self)
+        _to_si(self, {"L_start": "section_ramp", "L_end": "section_ramp", "speed": "chain_speed"}, "chain lift")
         if not (np.isfinite(self.speed) and self.speed > 0):
             raise InputError(f"chain lift: speed must be positive, got {self.speed!r} m/s")
         if not (self.L_end > self.L_start):
             raise InputError(f"chain lift: need L_end > L_start, got [{self.L_start!r}, {self.L_end!r}] m")
+        check("chain_speed", self.speed, where="chain lift speed", accept=acc)
 
     @property
     def duration(self) -> float:
@@ -457,12 +581,16 @@ class Train:
     """
 
     def __init__(self, track: FramedCurve, params: TrainParameters | None = None, gravity: float = G,
-                 name: str = "train"):
+                 name: str = "train", accept=()):
+        from .inputs import check
+
         if not isinstance(track, FramedCurve):
             raise InputError(f"Train {name!r}: track must be a core.curves.FramedCurve, got {type(track).__name__}")
+        if params is not None and not isinstance(params, TrainParameters):
+            raise InputError(f"Train {name!r}: params must be a TrainParameters, got {type(params).__name__}")
         self.track = track
         self.p = TrainParameters() if params is None else params
-        self.gravity = float(gravity)
+        self.gravity = float(check("gravity", gravity, where=f"Train {name!r} gravity", accept=accept))
         self.name = name
         nc = self.p.n_cars
         self.cars = [f"car{k + 1}" for k in range(nc)]
@@ -529,10 +657,36 @@ class Train:
             Lf = _root_behind(f, Lr_prev - (2 * e + lb), 0.25 * (2 * e + lb), f"the front wheelset of car {k + 1}")
             Ls += [Lf, self._car_rear_L(Lf)]
         out = np.array(Ls)
+        self._check_on_track(L1, out)
         if len(self._cache) > 4096:
             self._cache.clear()
         self._cache[L1] = out
         return out.copy()
+
+    def _check_on_track(self, L1, Ls):
+        """Every wheelset of an open track within [0, length] (a closed track wraps)."""
+        if getattr(self.track, "closed", False):
+            return
+        length = float(self.track.length)
+        tol = 1e-9 * max(1.0, length)
+        span = float(Ls[0] - Ls[-1])
+        if Ls[-1] < -tol:
+            k = int(np.argmax(Ls < -tol))
+            if k < len(Ls) - 1:
+                who = (f"the wheelsets {self.wheelsets[k]} ... {self.wheelsets[-1]} (cars {k // 2 + 1} ... "
+                       f"{self.p.n_cars}) would be")
+            else:
+                who = f"the rear wheelset {self.wheelsets[-1]} would be"
+            raise InputError(
+                f"Train {self.name!r}: with the lead wheelset at L1 = {L1:.6g} m {who} before the start of the open "
+                f"track {getattr(self.track, 'name', '')!r} (L = 0; the last at L = {float(Ls[-1]):.4g} m): place the "
+                f"lead wheelset at "
+                f"L1 >= {span:.4g} m (the train spans {span:.4g} m from its first to its last wheelset)")
+        if Ls[0] > length + tol:
+            raise InputError(
+                f"Train {self.name!r}: the lead wheelset at L1 = {L1:.6g} m is beyond the end of the open track "
+                f"{getattr(self.track, 'name', '')!r} (L = {length:.6g} m): place it at "
+                f"{span:.4g} m <= L1 <= {length:.6g} m")
 
     def poses(self, L1: float) -> dict:
         """Body poses {name: (r (3,), A (3, 3))} of the train assembled at lead arc length ``L1``."""
@@ -650,8 +804,25 @@ class Train:
             q[model.n_bodies * 7 + model.extra_names.index(Lname)] = L
         return q, self.velocities(model, q, speed)
 
-    def forces(self, rolling=0.0, drag_area=0.0, air_density=1.225, sections=(), name="track_forces") -> TrackForces:
-        """A :class:`TrackForces` element on this train's coordinates (period = track length if closed)."""
+    def forces(self, rolling=0.0, drag_area=0.0, air_density=1.225, sections=(), name="track_forces",
+               accept=()) -> TrackForces:
+        """A :class:`TrackForces` element on this train's coordinates (period = track length if closed).
+
+        ``rolling`` (c_rr, a fraction: "2.5 %" or 0.025), ``drag_area`` (m²) and ``air_density``
+        (kg/m³) are checked against their plausible ranges (``accept`` names outliers); a
+        section beyond the end of an open track is refused.
+        """
+        from .inputs import check
+
+        where = f"Train {self.name!r}.forces"
+        rolling = float(check("rolling", rolling, where=f"{where}(rolling=...)", accept=accept))
+        drag_area = float(check("drag_area", drag_area, where=f"{where}(drag_area=...)", accept=accept))
+        air_density = float(check("air_density", air_density, where=f"{where}(air_density=...)", accept=accept))
+        if not getattr(self.track, "closed", False):
+            for sec in sections:
+                if sec.L_start < 0 or sec.L_end > self.track.length:
+                    raise InputError(f"{where}: speed section {sec.name!r} [{sec.L_start:g}, {sec.L_end:g}] m lies "
+                                     f"outside the open track [0, {self.track.length:.6g}] m")
         period = float(self.track.length) if getattr(self.track, "closed", False) else 0.0
         return TrackForces(name, tuple(self.coordinates), tuple(self.p.wheelset_loads()), rolling=rolling,
                            drag_area=drag_area, air_density=air_density, sections=tuple(sections), period=period,
@@ -757,13 +928,72 @@ class TrainRun:
 
     @property
     def real_time_factor(self) -> float:
-        """Simulated time / integration wall time (> 1: faster than real time)."""
+        """Simulated time / integration wall time (> 1: faster than real time).
+
+        The first run of a process includes the compilation (or loading from numba's cache) of
+        the kernels in its wall time: warm up with a short run first (the circuit scene and
+        benchmarks/coaster_circuit.py do, and report the warm-up's wall time on its own)."""
         return float((self.t[-1] - self.t[0]) / self.wall_time) if self.wall_time > 0 else float("inf")
 
     def energy(self) -> np.ndarray:
         """T + V (J) at the output times (gravity; the track forces have no potential)."""
         m = self.models[0]
         return np.array([m.energy(t, q, v) for t, q, v in zip(self.t, self.q, self.v)])
+
+    def states_at(self, times) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """States at arbitrary times of the run, by re-integrating from the output before each.
+
+        For a time t with t_i <= t <= t_(i+1) (outputs of the run) the phase model of row i+1
+        is integrated from the state of row i (projected onto the constraints) to t with the
+        run's method and tolerances: the state agrees with the run's own dense solution to the
+        integration tolerance, independently of the output step.  Times sharing a start row are
+        integrated in one call.
+
+        Parameters
+        ----------
+        times : (m,) array_like
+            Times within [t_0, t_end] (s).
+
+        Returns
+        -------
+        (phase (m,) int, q (m, n_q), v (m, n_v), t (m,)) in the order of ``times``.
+        """
+        from core.dynamics import project
+        from core.simulation import simulate
+
+        T = np.atleast_1d(np.asarray(times, float)).reshape(-1)
+        if T.size and (np.min(T) < self.t[0] - 1e-12 or np.max(T) > self.t[-1] + 1e-12):
+            raise InputError(f"states_at: times must lie within the run [{self.t[0]:g}, {self.t[-1]:g}] s")
+        T = np.clip(T, self.t[0], self.t[-1])
+        start = np.clip(np.searchsorted(self.t, T, side="right") - 1, 0, len(self.t) - 1)
+        ph = np.empty(T.size, int)
+        Q = np.empty((T.size, self.q.shape[1]))
+        Vv = np.empty((T.size, self.v.shape[1]))
+        meta = self.meta
+        for i in np.unique(start):
+            sel = np.flatnonzero(start == i)
+            k = int(self.phase[min(i + 1, len(self.t) - 1)])
+            model = self.models[k]
+            ts = np.unique(T[sel])
+            exact = ts <= self.t[i] + 1e-13
+            out = {}
+            for tt in ts[exact]:
+                out[float(tt)] = (self.q[i], self.v[i])
+            if not np.all(exact):
+                qi, vi, _ = project(model, float(self.t[i]), self.q[i].copy(), self.v[i].copy(),
+                                    tol=min(meta.get("atol", 1e-8), 1e-10))
+                te = np.concatenate([[self.t[i]], ts[~exact]])
+                res = simulate(model, (float(self.t[i]), float(te[-1])), meta.get("method", "jit-dop853-projection"),
+                               q0=qi, v0=vi, t_eval=te, rtol=meta.get("rtol", 1e-8), atol=meta.get("atol", 1e-8),
+                               compute_multipliers=False)
+                if res.status == "failed" or len(res.t) != len(te):
+                    raise RuntimeError(f"states_at: re-integration from t = {self.t[i]:.6g} s failed: {res.message}")
+                for tt, qq, vv in zip(te[1:], res.q[1:], res.v[1:]):
+                    out[float(tt)] = (qq, vv)
+            for j in sel:
+                qq, vv = out[float(T[j])]
+                ph[j], Q[j], Vv[j] = k, qq, vv
+        return ph, Q, Vv, T
 
     def table(self) -> pd.DataFrame:
         """Lead arc length, speed, acceleration along the track, height, energy, phase: one row per output."""
@@ -826,7 +1056,8 @@ def _section_at(sections: pd.DataFrame | None, L: float, period: float) -> str:
 def run_train(train: Train, L_start: float, speed: float, L_stop: float, *, chain: ChainLift | None = None,
               forces: TrackForces | None = None, method: str = "jit-dop853-projection", rtol: float = 1e-8,
               atol: float = 1e-8, output_step: float = 0.05, chunk: float = 10.0, t_max: float = 600.0,
-              max_step: float = np.inf, sections: pd.DataFrame | None = None, progress=None) -> TrainRun:
+              max_step: float = np.inf, sections: pd.DataFrame | None = None, progress=None,
+              accept=()) -> TrainRun:
     r"""Run the train from lead arc length ``L_start`` at lead speed ``speed`` until ``L_stop``.
 
     With ``chain`` the first phase drives L_1 at the chain speed from ``chain.L_start`` (= ``L_start``,
@@ -856,19 +1087,38 @@ def run_train(train: Train, L_start: float, speed: float, L_stop: float, *, chai
         Largest simulated time (s).
     sections : pandas.DataFrame, optional
         Named sections (:func:`circuit_sections`) for the messages.
+    accept : sequence of str
+        Quantities whose plausible range is not enforced (``track_speed``, ``output_step``).
 
     Returns
     -------
     TrainRun
+
+    Notes
+    -----
+    On an open track a run that reaches its end (or, rolling back, its start) ends with status
+    ``"failed"`` and a message naming the end of the track; the rows computed up to there are
+    kept.  The centreline is never extrapolated (the path joint refuses an arc length outside
+    the track: :class:`core.errors.DataRangeError` on the numpy path, ``OUT_OF_RANGE`` on the
+    compiled one).  ``speed`` may be a string with its unit ("29 km/h"); it and
+    ``output_step`` are checked against their plausible ranges.
     """
     from core.dynamics import project
+    from core.inputs import parse_quantity
     from core.simulation import simulate
 
+    from .inputs import check
+
+    speed = float(parse_quantity(speed, "m/s", where="run_train(speed=...)"))
+    check("track_speed", abs(speed), where="run_train(speed=...)", accept=accept)
+    output_step = float(check("output_step", output_step, where="run_train(output_step=...)", accept=accept))
     if not (np.isfinite(L_stop) and L_stop > L_start):
         raise InputError(f"run_train: L_stop must be beyond L_start = {L_start!r} m, got {L_stop!r}")
     if output_step <= 0 or chunk <= 0:
         raise InputError(f"run_train: output_step and chunk must be > 0, got {output_step!r}, {chunk!r}")
     period = float(train.track.length) if getattr(train.track, "closed", False) else 0.0
+    track_name = getattr(train.track, "name", "track")
+
     ts, qs, vs, accs, ph, lams, models, rows = [], [], [], [], [], [], [], []
     wall = 0.0
     t0 = 0.0
@@ -881,6 +1131,10 @@ def run_train(train: Train, L_start: float, speed: float, L_stop: float, *, chai
         ts.append(T), qs.append(Q), vs.append(V), accs.append(A), ph.append(np.full(len(T), k))
         return Lm
 
+    open_length = None if period else float(train.track.length)
+    if open_length is not None and chain is not None and chain.L_end > open_length:
+        raise InputError(f"run_train: the chain lift ends at L = {chain.L_end:g} m, beyond the end of the open track "
+                         f"{track_name!r} (L = {open_length:.6g} m)")
     if chain is not None:
         if abs(chain.L_start - L_start) > 1e-9 or abs(chain.speed - speed) > 1e-12:
             raise InputError(f"run_train: the chain lift starts at L = {chain.L_start!r} m at {chain.speed!r} m/s; "
@@ -928,6 +1182,23 @@ def run_train(train: Train, L_start: float, speed: float, L_stop: float, *, chai
         cut = len(res.t)
         rev = np.flatnonzero(np.sign(Ld[1:]) * sign0 < 0)
         done = np.flatnonzero(L1 >= L_stop)
+        if open_length is not None:  # the centreline is extrapolated past an open track's ends: cut there
+            Lrear = res.q[:, iq + len(train.coordinates) - 1]
+            off = np.flatnonzero((L1 > open_length) | (Lrear < 0.0))
+            if len(off) and (not len(done) or off[0] <= done[0]) and (not len(rev) or off[0] <= rev[0] + 1):
+                k = int(off[0])
+                ahead = L1[k] > open_length
+                x = (L1 - open_length) if ahead else -Lrear
+                tz = res.t[k - 1] + (res.t[k] - res.t[k - 1]) * (-x[k - 1]) / (x[k] - x[k - 1]) if k else res.t[0]
+                status = STATUS_FAILED
+                message = (f"free running: the train reached the {'end' if ahead else 'start'} of the open track "
+                           f"{track_name!r} (L = {open_length if ahead else 0.0:.6g} m) at t = {tz:.4g} s "
+                           f"({'lead wheelset ws1' if ahead else 'rear wheelset ' + train.wheelsets[-1]}); the "
+                           f"centreline is not extrapolated: the rows up to there are kept; "
+                           + (f"stop before the end (L_stop <= {open_length:.6g} m) or extend the track" if ahead
+                              else "the train ran backwards off the start"))
+                rev, done = rev[:0], done[:0]
+                cut = max(k, 1)
         if len(rev) and (not len(done) or rev[0] + 1 <= done[0]):
             i = int(rev[0])
             tz = res.t[i] + (res.t[i + 1] - res.t[i]) * Ld[i] / (Ld[i] - Ld[i + 1])
@@ -960,6 +1231,220 @@ def run_train(train: Train, L_start: float, speed: float, L_stop: float, *, chai
     return TrainRun(train, T, np.vstack(qs), np.vstack(vs), np.vstack(accs), np.concatenate(ph), lams, models,
                     pd.DataFrame(rows), status, message, wall,
                     meta={"method": method, "rtol": rtol, "atol": atol, "output_step": output_step, "chunk": chunk})
+
+
+def section_extremes(run: TrainRun, channels, names, sections: pd.DataFrame | None = None,
+                     n_fine: int = 12) -> pd.DataFrame:
+    r"""Maximum and minimum of functions of the state per track section, independent of the output step.
+
+    A statistic read from a run's outputs moves with the output step, most where the extreme
+    lies at a section boundary or between two outputs.  Here, per contiguous occurrence of a
+    section (the section of the lead wheelset's arc length L_1) and for each channel and sign:
+
+    1. the section's boundaries are located in time (L_1(t*) = L_b: linear guess between the
+       outputs, Newton steps t* <- t* - (L_1(t*) - L_b)/dL_1/dt on the re-integrated state) and
+       the channels are evaluated there (a boundary state belongs to both sections);
+    2. around the extreme output sample the channel is evaluated at ``n_fine`` times between its
+       two neighbours (clipped to the section), then at ``n_fine`` times within one fine spacing
+       of the best, and at the vertex of the parabola through the best and its two neighbours;
+
+    with states from :meth:`TrainRun.states_at` (re-integration at the run's tolerance) and the
+    accelerations and multipliers of the index-1 solve there.  The extreme is the largest of all
+    evaluated values: the true one up to the integration error and the parabola's residual on
+    the last grid (spacing 4 dt/n_fine^2 for an output step dt).
+
+    Parameters
+    ----------
+    run : TrainRun
+    channels : callable
+        ``channels(k, t, q, v, a, lam) -> (m,) array``: the values at one state of phase ``k``
+        (``run.models[k]``), with accelerations ``a`` and multipliers ``lam``.
+    names : sequence of str
+        The m channel names (columns ``{name} max``, ``{name} min``, ``t of {name} max``, ...).
+    sections : pandas.DataFrame, optional
+        ``section``, ``L_start [m]``, ``L_end [m]`` (e.g. :func:`circuit_sections`); default one
+        section ``"all"``.
+    n_fine : int
+        Evaluations per refinement pass (>= 3).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per section, in order of first appearance.
+    """
+    names = list(names)
+    if int(n_fine) < 3:
+        raise InputError(f"section_extremes: n_fine must be >= 3, got {n_fine!r}")
+    period = float(run.train.track.length) if getattr(run.train.track, "closed", False) else 0.0
+    L1 = run.L[:, 0]
+    t = run.t
+    if sections is None:
+        labels = np.array(["all"] * len(t), dtype=object)
+        bounds = {}
+    else:
+        labels = np.array([_section_at(sections, x, period) for x in L1], dtype=object)
+        bounds = {str(r["section"]): (float(r["L_start [m]"]), float(r["L_end [m]"])) for _, r in sections.iterrows()}
+    cache = {}
+
+    def values(times):
+        times = np.asarray(times, float)
+        need = [float(x) for x in np.unique(times) if float(x) not in cache]
+        if need:
+            ph, Q, V, _ = run.states_at(need)
+            for p_ in np.unique(ph):
+                sel = np.flatnonzero(ph == p_)
+                m = run.models[p_]
+                iq, iv = run.train.lead_index(m)
+                A, Lm = _accelerations(m, np.asarray(need)[sel], Q[sel], V[sel])
+                for j, k in enumerate(sel):
+                    x = np.asarray(channels(int(p_), need[k], Q[k], V[k], A[j], Lm[j]), float)
+                    cache[need[k]] = (x, float(Q[k, iq]), float(V[k, iv]))
+        return [cache[float(x)] for x in times]
+
+    first_row = {int(k): int(np.flatnonzero(run.phase == k)[0]) for k in np.unique(run.phase)}
+    for i, tt in enumerate(t):  # the output samples themselves (the run's accelerations and multipliers)
+        k = int(run.phase[i])
+        x = np.asarray(channels(k, tt, run.q[i], run.v[i], run.vdot[i], run.lam[k][i - first_row[k]]), float)
+        cache[float(tt)] = (x, float(L1[i]), float(run.Ldot[i, 0]))
+
+    def crossing(i, Lb):
+        """Time in [t_i, t_i+1] where L_1 (mod period) passes the boundary Lb."""
+        a, b = L1[i], L1[i + 1]
+        if period:
+            Lb = Lb + period * np.floor(min(a, b) / period)
+            if Lb < min(a, b) - 1e-9:
+                Lb += period
+        x = (Lb - a) / (b - a) if b != a else 0.0
+        tc = float(t[i] + np.clip(x, 0.0, 1.0) * (t[i + 1] - t[i]))
+        for _ in range(2):
+            (_, L, Ld), = values([tc])
+            if Ld == 0.0:
+                break
+            tc = float(np.clip(tc - (L - Lb) / Ld, t[i], t[i + 1]))
+        values([tc])
+        return tc
+
+    occ = []  # contiguous occurrences of a section: [name, first row, last row, entry time, exit time]
+    i0 = 0
+    for i in range(1, len(t) + 1):
+        if i == len(t) or labels[i] != labels[i0]:
+            occ.append([labels[i0], i0, i - 1, None, None])
+            i0 = i
+    for k in range(len(occ) - 1):
+        name, b = occ[k][0], occ[k][2]
+        forward = L1[b + 1] >= L1[b]
+        Lb = bounds.get(occ[k + 1][0] if forward else name, (None,))[0]
+        tc = 0.5 * (t[b] + t[b + 1]) if Lb is None else crossing(b, Lb)
+        values([tc])
+        occ[k][4] = tc
+        occ[k + 1][3] = tc
+    out = {}
+    for name, a, b, te, tx in occ:
+        lo = float(t[a]) if te is None else te
+        hi = float(t[b]) if tx is None else tx
+        base = [float(x) for x in t[a:b + 1]] + [x for x in (te, tx) if x is not None]
+        for c, ch in enumerate(names):
+            for sgn, tag in ((1.0, "max"), (-1.0, "min")):
+                vals = {x: sgn * cache[x][0][c] for x in base}
+
+                def add(grid):
+                    for x, (n, _, _) in zip(grid, values(grid)):
+                        vals[float(x)] = sgn * n[c]
+
+                k = max(range(a, b + 1), key=lambda j: vals[float(t[j])])
+                w0 = max(lo, float(t[max(k - 1, 0)]))
+                w1 = min(hi, float(t[min(k + 1, len(t) - 1)]))
+                if w1 > w0:
+                    add(np.linspace(w0, w1, n_fine))
+                    best = max(vals, key=vals.get)
+                    h = (w1 - w0) / (n_fine - 1)
+                    grid = np.linspace(max(lo, best - h), min(hi, best + h), n_fine)
+                    add(grid)
+                    best = max(vals, key=vals.get)
+                    hh = grid[1] - grid[0]
+                    if hh > 0 and lo <= best - hh and best + hh <= hi:
+                        tp = np.array([best - hh, best, best + hh])
+                        add(tp)
+                        yp = np.array([vals[float(x)] for x in tp])
+                        den = yp[0] - 2 * yp[1] + yp[2]
+                        if den < 0:
+                            tv = float(best + 0.5 * hh * (yp[0] - yp[2]) / den)
+                            if lo <= tv <= hi:
+                                add([tv])
+                best = max(vals, key=vals.get)
+                key = f"{ch} {tag}"
+                row = out.setdefault(name, {"section": name})
+                v = sgn * vals[best]
+                if key not in row or sgn * v > sgn * row[key]:
+                    row[key] = v
+                    row[f"t of {ch} {tag}"] = best
+    df = pd.DataFrame(list(out.values()))
+    cols = ["section"] + [f"{ch} {tag}" for ch in names for tag in ("max", "min")]
+    df = df[cols + [c for c in df.columns if c not in cols]]
+    df.attrs["method"] = (f"extremes at the outputs, at the section boundaries and refined by two passes of {n_fine} "
+                          f"re-integrated states and a parabola (coaster.train.section_extremes)")
+    return df
+
+
+def rider_peaks(run: TrainRun, car: str = "car1", rider_point=None, sections: pd.DataFrame | None = None,
+                n_fine: int = 12) -> pd.DataFrame:
+    """Peak rider load factors per track section, independent of the output step.
+
+    :func:`section_extremes` of the load factor n at the rider point (:mod:`coaster.rider`, car
+    axes x forward, y left, z up).
+
+    Parameters
+    ----------
+    run : TrainRun
+    car : str
+        Car body of the rider.
+    rider_point : (3,) array_like, optional
+        Rider point in car axes (m); default the train's ``rider_point``.
+    sections : pandas.DataFrame, optional
+        As :func:`section_extremes`.
+    n_fine : int
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``section``, ``n_x max [g]``, ``n_x min [g]``, ``n_y max [g]``, ``n_y min [g]``,
+        ``n_z max [g]``, ``n_z min [g]``, ``|n_y| max [g]``, and the time of each extreme
+        (``t of n_z max [s]``, ...).
+    """
+    from .rider import _Rider
+
+    rp = run.train.p.rider_point if rider_point is None else rider_point
+    riders = [_Rider(m, car, rp, None) for m in run.models]
+    df = section_extremes(run, lambda k, t, q, v, a, lam: riders[k].loads_given(q, v, a)[0],
+                          ["n_x", "n_y", "n_z"], sections, n_fine)
+    df = df.rename(columns=lambda c: f"{c} [g]" if c.startswith("n_") else f"{c} [s]" if c.startswith("t of") else c)
+    df.insert(7, "|n_y| max [g]", np.maximum(df["n_y max [g]"], -df["n_y min [g]"]))
+    return df
+
+
+def wheel_force_peaks(run: TrainRun, sections: pd.DataFrame | None = None, n_fine: int = 12) -> pd.DataFrame:
+    """Extreme wheel forces over all wheelsets per track section, independent of the output step.
+
+    :func:`section_extremes` of max_i F_b,i, min_i F_b,i and max_i |F_n,i| over the wheelsets
+    (the path joints' reactions in the track frame, :func:`wheel_forces`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``section``, ``F_b max [kN]``, ``F_b min [kN]``, ``|F_n| max [kN]`` and their times.
+    """
+    joints = run.train.path_joints
+
+    def ch(k, t, q, v, a, lam):
+        m = run.models[k]
+        F = np.array([j.reactions(q, j.joint_multipliers(m, lam)) for j in joints]).reshape(len(joints), 6)
+        return np.array([F[:, 2].max(), F[:, 2].min(), np.abs(F[:, 1]).max()]) / 1e3
+
+    df = section_extremes(run, ch, ["F_b hi", "F_b lo", "|F_n|"], sections, n_fine)
+    out = pd.DataFrame({"section": df["section"], "F_b max [kN]": df["F_b hi max"], "F_b min [kN]": df["F_b lo min"],
+                        "|F_n| max [kN]": df["|F_n| max"], "t of F_b max [s]": df["t of F_b hi max"],
+                        "t of F_b min [s]": df["t of F_b lo min"], "t of |F_n| max [s]": df["t of |F_n| max"]})
+    return out
 
 
 def wheel_forces(run: TrainRun) -> pd.DataFrame:

@@ -49,3 +49,15 @@ def test_circuit_frame_quality(out):
     assert fq["max rotation step / (|omega| dL) [-]"] < 1.05
     assert fq["frame closure max |R(length) - R(0)| [-]"] < 1e-9
     assert (out / "frame_quality.png").is_file()
+
+
+def test_circuit_scene_bank_study_and_warm_up(out):
+    """Issue 21: the circuit's outward bank is flagged in the notes, the designed bank lowers the rider's
+    lateral load, and the real-time factor is of a run after the compiling warm-up (reported on its own)."""
+    runs = pd.read_csv(out / "runs.csv")
+    assert runs["compilation + warm-up wall [s]"].iloc[0] > 0
+    bank = pd.read_csv(out / "bank_design.csv")
+    assert bank["outward share of v2k [-]"].iloc[0] > 0.9 and bank["outward share of v2k [-]"].iloc[1] < 0.05
+    assert bank["rider |n_y| RMS [g]"].iloc[1] < 0.25 * bank["rider |n_y| RMS [g]"].iloc[0]
+    assert (bank["run status"] == "finished").all()
+    assert "OutwardBankWarning" in (out / "README.md").read_text()

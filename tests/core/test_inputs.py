@@ -159,10 +159,7 @@ def test_shipped_range_tables_are_consistent(domain):
     from core.inputs import unit_registry
     from core.paths import data_path
 
-    path = data_path(domain, "plausible_ranges.csv", must_exist=False)
-    if not path.exists():
-        pytest.skip(f"{domain} has no range table")
-    t = RangeTable.from_csv(path)
+    t = RangeTable.from_csv(data_path(domain, "plausible_ranges.csv"))
     ureg = unit_registry()
     for r in t:
         ureg.Quantity(1.0, r.unit)
@@ -189,3 +186,14 @@ def test_duplicate_quantity_in_range_table_is_refused(tmp_path):
     p.write_text("quantity,label,unit,low,high,rationale\nm,mass,kg,1,2,x\nm,mass,kg,1,3,y\n")
     with pytest.raises(DataFileError, match="'m' appears twice"):
         RangeTable.from_csv(p)
+
+
+@pytest.mark.parametrize("domain", ["railway", "biomech", "coaster"])
+def test_readme_range_tables_equal_the_data(domain):
+    """The README's "Checked inputs" tables are RangeTable.to_markdown() of the shipped CSVs:
+    a range changed in the data without the README (or the reverse) fails here."""
+    from core.paths import data_path, repo_root
+
+    readme = (repo_root() / "README.md").read_text(encoding="utf-8")
+    table = RangeTable.from_csv(data_path(domain, "plausible_ranges.csv")).to_markdown()
+    assert table in readme, f"README's {domain} range table differs from data/{domain}/plausible_ranges.csv"

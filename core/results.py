@@ -34,6 +34,7 @@ import pandas as pd
 from .paths import output_folder, write_atomically
 
 __all__ = [
+    "AcceptedSteps",
     "FinalState",
     "SimulationResult",
     "environment_versions",
@@ -255,6 +256,28 @@ class FinalState(NamedTuple):
     lam: np.ndarray | None
 
 
+class AcceptedSteps(NamedTuple):
+    r"""The state at every accepted step of a run (``simulate(..., record_steps=True)``).
+
+    The output grid ``t_k`` samples the motion; the accepted steps ``t_0 < t_1 < … < t_N`` are
+    where the integrator's error control held it to the tolerance, so a quantity evaluated
+    there (and located between them, :mod:`core.signals`) does not depend on the output step.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n_steps + 1,)
+        Start time and the end time of every accepted step [s], strictly increasing.
+    q : ndarray, shape (n_steps + 1, n_q)
+        Coordinates there.
+    v : ndarray, shape (n_steps + 1, n_v)
+        Velocities there.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+
+
 def _readonly(name: str, value: Any, ndim: int) -> np.ndarray:
     try:
         arr = np.asarray(value, dtype=float)
@@ -309,6 +332,9 @@ class SimulationResult:
         Joint reaction forces/torques per joint name.
     reaction_names : dict of str to list of str, optional
         Column names per joint, e.g. ``["Fx [N]", "Fy [N]", "Mz [N m]"]``.
+    steps : AcceptedSteps, optional
+        The state at every accepted step (``simulate(..., record_steps=True)``): the dense
+        record from which statistics that must not depend on the output grid are taken.
 
     Notes
     -----
@@ -333,6 +359,7 @@ class SimulationResult:
     energy: np.ndarray | None = None
     reactions: dict[str, np.ndarray] = field(default_factory=dict)
     reaction_names: dict[str, list[str]] = field(default_factory=dict)
+    steps: AcceptedSteps | None = None
 
     # -- validation ---------------------------------------------------------------
     def __post_init__(self) -> None:  # noqa: C901 - one check per field, in order
@@ -431,6 +458,17 @@ class SimulationResult:
             reaction_names[joint] = names
         put(self, "reactions", reactions)
         put(self, "reaction_names", reaction_names)
+
+        if self.steps is not None:
+            st_t = _readonly("steps.t", self.steps[0], 1)
+            st_q = _readonly("steps.q", self.steps[1], 2)
+            st_v = _readonly("steps.v", self.steps[2], 2)
+            if st_q.shape != (st_t.size, self.q.shape[1]) or st_v.shape != (st_t.size, self.v.shape[1]):
+                raise ValueError(f"SimulationResult.steps: q {st_q.shape} and v {st_v.shape} must have one row per "
+                                 f"step time ({st_t.size}) and the columns of q and v")
+            if np.any(np.diff(st_t) <= 0):
+                raise ValueError("SimulationResult.steps.t must be strictly increasing")
+            put(self, "steps", AcceptedSteps(st_t, st_q, st_v))
 
     def _set_names(self, attr: str, n: int, prefix: str) -> None:
         names = getattr(self, attr)

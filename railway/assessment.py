@@ -72,6 +72,14 @@ the samples)::
 which scales a harmonic of wavelength L by sin(pi w / L) / (pi w / L).  The processing
 parameters are the defaults of the functions, not limits.
 
+Events and peaks (:func:`wheel_event_statistics`) are taken from the accepted steps of the run
+(``simulate(..., record_steps=True)``, ``contact_history(..., at="steps")``), not from the output
+grid: wheel lift is the set where Q = 0, its boundaries located by bisection on Q > 0 inside the
+step (event location); the time with Y/Q above a limit and the peaks of Q, |Y|, Y/Q and the
+flange force are taken over every accepted step (:mod:`core.signals`).  So they do not change
+with the output step, and a lift shorter than it is found; the table says how many of the
+events the output grid of the run would not show.
+
 References
 ----------
 Nadal, M. J. (1908). Locomotives a vapeur. Collection Encyclopedie Scientifique, Paris (A1;
@@ -101,6 +109,7 @@ __all__ = [
     "lowpass",
     "sliding_mean",
     "wheel_force_statistics",
+    "wheel_event_statistics",
 ]
 
 #: processing of the track-test quantities as quoted from EN 14363 / UIC 518 (module docstring):
@@ -434,7 +443,9 @@ def wheel_force_statistics(H, cutoff=CUTOFF_HZ, window=WINDOW_M, step=SAMPLING_M
     columns ``t [s]``, ``wheel``, ``wheelset``, ``s [m]``, ``Q [N]``, ``Y [N]``, ``sum Y [N]``.
 
     Per wheel: Q low-pass filtered at ``cutoff`` and its percentiles (``Q high [N]``, ``Q low
-    [N]``), the unfiltered extremes (``Q max, unfiltered [N]``, ``Q min, unfiltered [N]``), |Y|
+    [N]``), the unfiltered extremes of the samples (``Q max, unfiltered [N]``, ``Q min, unfiltered
+    [N]``: extremes of this output grid, which change with its step; the peaks of the run are
+    those of :func:`wheel_event_statistics`, from every accepted step), |Y|
     filtered, its upper percentile (``|Y| high [N]``); Y/Q of the filtered forces as a sliding
     mean over ``window`` m, its upper percentile (``(Y/Q) 2 m high [-]``); per wheelset the same
     of the filtered sum Y, the largest magnitude of its two percentiles (``(sum Y) 2 m high
@@ -472,3 +483,100 @@ def wheel_force_statistics(H, cutoff=CUTOFF_HZ, window=WINDOW_M, step=SAMPLING_M
                      "(Y/Q) 2 m high [-]": float(np.nanpercentile(yq_w, hi)),
                      "(sum Y) 2 m high [N]": float(max(abs(np.percentile(sy_w, lo)), abs(np.percentile(sy_w, hi))))})
     return pd.DataFrame(rows)
+
+
+def wheel_event_statistics(H, output_times=None, yq_limit=None, warn=True):
+    """Wheel lift, peaks and exceedances per wheel from the dense record of a run.
+
+    Parameters
+    ----------
+    H : DataFrame
+        :func:`railway.wheel_rail.contact_history` with ``at="steps"`` (every accepted step of a
+        run made with ``record_steps=True``); its ``attrs["lift crossings"]`` give the located
+        lift-off and touch-down times (else they are interpolated, to one step).  A table on
+        the output grid is refused: its statistics would change with the output step.
+    output_times : (n_t,) array_like, optional
+        The output grid of the run (``result.t``): the table then counts the lifts and the
+        Y/Q exceedances that fall between two output times (the grid does not show them) and,
+        with ``warn``, issues a :class:`core.signals.GridResolutionWarning` naming the wheel.
+    yq_limit : float, optional
+        Limit of Y/Q for the time above it; default the Y/Q value of :func:`assessment_limits`.
+
+    Returns
+    -------
+    DataFrame
+        One row per wheel: ``lift-off first [s]`` (NaN: never lifted), ``lifts``, ``lifted
+        [s]`` (total time with Q = 0), ``shortest lift [s]``, ``lift timing resolution [s]``,
+        ``Q max [N]`` and ``t at Q max [s]``, ``Q min [N]``, ``|Y| max [N]``, ``Y/Q max [-]``
+        and its time, ``flange force max [N]``, ``Y/Q above limit [s]`` and ``Y/Q
+        exceedances`` (with ``Y/Q limit [-]``), ``accepted steps``; with ``output_times`` also
+        ``lifts between outputs`` and ``Y/Q exceedances between outputs``.  ``attrs`` state the
+        source.
+
+    Raises
+    ------
+    core.errors.InputError
+        A table not evaluated at the accepted steps, or missing columns.
+    """
+    from core.signals import level_summary, peak
+
+    if H.attrs.get("at") != "steps":
+        raise InputError("wheel_event_statistics: H must be a contact history at the accepted steps "
+                         "(contact_history(model, result, at='steps') of a run with record_steps=True); statistics "
+                         "of the output grid change with the output step")
+    need = {"t [s]", "wheel", "Q [N]", "Y [N]", "Y/Q [-]", "flange force [N]"}
+    if not need <= set(H.columns):
+        raise InputError(f"wheel_event_statistics: H lacks the columns {sorted(need - set(H.columns))}")
+    if yq_limit is None:
+        lim = assessment_limits()
+        yq_limit = float(lim.loc[lim["quantity"] == "Y/Q", "limit [-]"].iloc[0])
+    crossings = H.attrs.get("lift crossings", {})
+    tol = float(H.attrs.get("lift tolerance [s]", 0.0))
+    rows = []
+    for wheel, g in H.groupby("wheel", sort=False):
+        g = g.sort_values("t [s]")
+        t = g["t [s]"].to_numpy(float)
+        Q = g["Q [N]"].to_numpy(float)
+        located = crossings.get(wheel)
+        refine = None
+        if located is not None:
+            def refine(ta, tb, located=located):  # noqa: E306 - per wheel
+                return located.get(tb, tb)
+        # lifted: Q = 0 exactly (the contact force of a separated wheel is zero); the level
+        # 0 with side "below" includes it
+        lift = level_summary(t, Q, 0.0, "below", refine, output_times, name=f"wheel {wheel!r} lift (Q = 0)",
+                             warn=warn)
+        yq = g["Y/Q [-]"].to_numpy(float)
+        exc = level_summary(t, yq, yq_limit, "above", None, output_times, name=f"wheel {wheel!r} Y/Q",
+                            warn=warn)
+        refined = H.attrs.get("peaks", {}).get(wheel, {})
+
+        def pk(col, kind, x):  # the refined peak of contact_history where it has one, else the samples'
+            if col in refined and refined[col][0] == kind and t[0] <= refined[col][2] <= t[-1]:
+                v_, t_ = refined[col][1:]  # (a table cut to a window keeps the refined peaks inside it)
+                return (v_, t_) if np.isfinite(v_) else (float("nan"), float("nan"))
+            return peak(t, x, kind)
+
+        q_max, t_q_max = pk("Q [N]", "max", Q)
+        q_min, _ = pk("Q [N]", "min", Q)
+        y_max, _ = pk("Y [N]", "absmax", g["Y [N]"].to_numpy(float))
+        y_max = abs(y_max)
+        yq_max, t_yq = pk("Y/Q [-]", "max", yq)
+        ff_max, _ = pk("flange force [N]", "max", g["flange force [N]"].to_numpy(float))
+        row = {"wheel": wheel, "lift-off first [s]": lift["first [s]"], "lifts": lift["count"],
+               "lifted [s]": lift["total [s]"], "shortest lift [s]": lift["shortest [s]"],
+               "lift timing resolution [s]": tol if located is not None and lift["count"] else lift["resolution [s]"],
+               "Q max [N]": q_max, "t at Q max [s]": t_q_max, "Q min [N]": q_min, "|Y| max [N]": y_max,
+               "Y/Q max [-]": yq_max, "t at Y/Q max [s]": t_yq, "flange force max [N]": ff_max,
+               "Y/Q limit [-]": float(yq_limit), "Y/Q above limit [s]": exc["total [s]"],
+               "Y/Q exceedances": exc["count"], "accepted steps": int(t.size)}
+        if output_times is not None:
+            row["lifts between outputs"] = lift["missed by the output grid"]
+            row["Y/Q exceedances between outputs"] = exc["missed by the output grid"]
+        rows.append(row)
+    df = pd.DataFrame(rows)
+    df.attrs["source"] = ("every accepted step of the run; Q = 0 crossings located by bisection"
+                          if crossings else "every accepted step of the run; crossings interpolated between steps")
+    df.attrs["peaks"] = ("refined by sampling the steps around each candidate extreme" if H.attrs.get("peaks")
+                         else "extreme samples at the accepted steps")
+    return df

@@ -452,8 +452,12 @@ def curving_track(curve_length=None):
 
 
 def run_curving(law, V, T=None, definition=None, track=None, method=METHOD, rtol=RTOL, n_output_per_s=20,
-                reseed_every=1):
-    """The coach through the curve at constant speed V (speed control); returns (result, vehicle)."""
+                reseed_every=1, record_steps=False):
+    """The coach through the curve at constant speed V (speed control); returns (result, vehicle).
+
+    ``record_steps``: keep the state at every accepted step (``result.steps``) for the wheel
+    events and peaks of :func:`railway.assessment.wheel_event_statistics`; the outputs and the
+    step sequence are the same either way."""
     from core.integrators import simulate
 
     from .vehicle import VehicleDefinition, build_vehicle
@@ -469,7 +473,7 @@ def run_curving(law, V, T=None, definition=None, track=None, method=METHOD, rtol
         c = CURVE
         T = (c["lead"] + c["transition"] + 0.5 * c["curve_length"] + 30.0 - 35.0) / V
     res = simulate(veh.model, (0.0, T), method, q0=q0, v0=v0, rtol=rtol, atol=rtol * 1e-2,
-                   n_output=int(T * n_output_per_s) + 1)
+                   n_output=int(T * n_output_per_s) + 1, record_steps=record_steps)
     return res, veh
 
 
@@ -487,6 +491,7 @@ def curve_window(H, curve_length=None):
 
 
 def _run_curving(ctx):
+    from .assessment import wheel_event_statistics
     from .vehicle import GRAVITY, VehicleDefinition
     from .wheel_rail import contact_history
 
@@ -494,16 +499,26 @@ def _run_curving(ctx):
     laws = ("polach2000", "kalker_linear") if ctx.fast else CREEP_LAWS
     speeds = (10.0,) if ctx.fast else (10.0, 20.0)
     Q0 = D.total_mass * GRAVITY / 8.0
-    qs_rows, eq_rows, runs = [], [], {}
+    qs_rows, eq_rows, ev_rows, runs = [], [], [], {}
     for V in speeds:
         for law in ctx.progress(laws, desc=f"curving {V:g} m/s"):
             T = None
             if ctx.fast:
                 T = 8.0
-            res, veh = run_curving(law, V, T=T, definition=D)
+            res, veh = run_curving(law, V, T=T, definition=D, record_steps=True)
             H = contact_history(veh.model, res)
             H["dQ/Q0 [-]"] = (Q0 - H["Q [N]"]) / Q0
-            runs[(law, V)] = (res, veh, H)
+            # wheel lift, peaks and Y/Q exceedances from every accepted step (Q = 0 located by
+            # bisection), not from the 20 Hz outputs: they do not change with the output step
+            Hs = contact_history(veh.model, res, at="steps")
+            ev = wheel_event_statistics(Hs, output_times=res.t, warn=False)
+            s_of = {w: g for w, g in Hs.groupby("wheel", sort=False)}
+            ev.insert(1, "lift-off first, s [m]", [
+                float(np.interp(t0, s_of[w]["t [s]"], s_of[w]["s [m]"])) if np.isfinite(t0) else np.nan
+                for w, t0 in zip(ev["wheel"], ev["lift-off first [s]"])])
+            for _, r in ev.iterrows():
+                ev_rows.append({"speed [m/s]": V, "creep law": law, "status": res.status, **r.to_dict()})
+            runs[(law, V)] = (res, veh, H, ev)
             W = curve_window(H)
             base = {"speed [m/s]": V, "creep law": law, "status": res.status}
             if res.status == "failed":
@@ -551,7 +566,7 @@ def _run_curving(ctx):
     for V in speeds:
         fig, ax = _fig(2, 1, size=(8, 6))
         for law in laws:
-            res, veh, H = runs[(law, V)]
+            res, veh, H, _ = runs[(law, V)]
             lead = H[H["wheel"] == f"{veh.wheelsets[0]} right"]
             ax[0, 0].plot(lead["s [m]"], lead["flange force [N]"] * 1e-3, lw=1, label=f"{law} [{res.status}]")
             ax[1, 0].plot(lead["s [m]"], lead["lateral displacement [m]"] * 1e3, lw=1, label=law)
@@ -572,7 +587,7 @@ def _run_curving(ctx):
         fig, ax = _fig(size=(8, 3.6))
         ax = ax[0, 0]
         for law in laws:
-            res, veh, H = runs[(law, V)]
+            res, veh, H, _ = runs[(law, V)]
             for side, ls in (("left", "--"), ("right", "-")):
                 w = H[H["wheel"] == f"{veh.wheelsets[0]} {side}"]
                 ax.plot(w["s [m]"], w["Q [N]"] * 1e-3, ls, lw=0.9, label=f"{law} {side}")
@@ -583,13 +598,16 @@ def _run_curving(ctx):
         ax.grid(True, alpha=0.3)
         figs[f"leading_wheel_loads_{int(V)}ms"] = fig
     lifted = []
-    for (law, V), (res, veh, H) in runs.items():
+    for (law, V), (res, veh, H, ev) in runs.items():
         for side, where in (("left", "inner"), ("right", "outer")):
-            w = H[H["wheel"] == f"{veh.wheelsets[0]} {side}"]
-            if (w["Q [N]"] <= 0).any():
+            r = ev[ev["wheel"] == f"{veh.wheelsets[0]} {side}"].iloc[0]
+            if r["lifts"] > 0:
+                n = int(r["lifts"])
                 lifted.append(f"{where} wheel with {law} at {V:g} m/s (first at s = "
-                              f"{float(w[w['Q [N]'] <= 0]['s [m]'].iloc[0]):.1f} m, "
-                              f"{int((w['Q [N]'] <= 0).sum())} of {len(w)} outputs)")
+                              f"{r['lift-off first, s [m]']:.1f} m, t = {r['lift-off first [s]']:.4f} s; "
+                              f"{n} lift{'s' if n > 1 else ''}, {r['lifted [s]'] * 1e3:.3g} ms in all, shortest "
+                              f"{r['shortest lift [s]'] * 1e3:.3g} ms; {int(r['lifts between outputs'])} of them "
+                              f"between two {1e3 * float(np.max(np.diff(res.t))):.0f} ms outputs)")
     c = CURVE
     nq = eq[~eq["quasi-static"].astype(bool)] if len(eq) and "quasi-static" in eq else eq.iloc[0:0]
     not_qs = ", ".join(f"{r['creep law']} at {r['speed [m/s]']:g} m/s" for _, r in nq.iterrows()) or "none"
@@ -605,8 +623,9 @@ def _run_curving(ctx):
         f"transitions. Lateral "
         f"equilibrium: the rail forces on the whole vehicle along the track's lateral axis against "
         f"m (a_c - g) . n (centripetal acceleration and gravity in the canted plane). Wheel lift (Q = 0) "
-        f"of the leading wheelset: {'; '.join(lifted) if lifted else 'none'}. Kalker's linear law does not "
-        f"saturate: in the curve its creep forces exceed mu N many times, which is what unloads (or "
+        f"of the leading wheelset (from every accepted step, the lift located by bisection to 0.1 us; "
+        f"table wheel_events, all wheels): {'; '.join(lifted) if lifted else 'none'}. Kalker's linear law "
+        f"does not saturate: in the curve its creep forces exceed mu N many times, which is what unloads (or "
         f"lifts) the wheels in the paper's Kalker-linear results; the saturating laws keep Y/Q of the "
         f"inner wheel near mu. Flange contact flag: contact angle above 45 deg. A row of the lateral "
         f"equilibrium table is 'quasi-static' when the standard deviation of the rail forces over the "
@@ -616,7 +635,10 @@ def _run_curving(ctx):
         f"\n\nReferences: Pombo & "
         f"Ambrosio (2008), Multibody Syst. Dyn. 19:91-114 (curving of the ML95 trailer, not available "
         f"here); Nadal (1908); Wickens (2003), ch. 7.")
-    tables = {"curving_quasi_static": _units(qs), "lateral_equilibrium": _units(eq)}
+    events = pd.DataFrame(ev_rows)
+    events.attrs["source"] = ("every accepted step of each run (railway.assessment.wheel_event_statistics); "
+                              "'lifts between outputs': lifts no output time falls in")
+    tables = {"curving_quasi_static": _units(qs), "lateral_equilibrium": _units(eq), "wheel_events": _units(events)}
     return dict(tables=tables, figures=figs, notes=notes)
 
 
@@ -660,7 +682,7 @@ def irregular_case(case):
     from .vehicle import GRAVITY, VehicleDefinition, build_vehicle
     from core.errors import InputError
 
-    from .assessment import wheel_force_statistics
+    from .assessment import wheel_event_statistics, wheel_force_statistics
     from .wheel_rail import contact_history
 
     V, length, law = case["speed"], case["length"], case.get("law", "polach2000")
@@ -675,7 +697,7 @@ def irregular_case(case):
     fs, fs_force = 200.0, 1000.0  # car-body accelerations; wheel forces (the ~200 Hz bounce resolved)
     sub = int(round(fs_force / fs))
     res = simulate(veh.model, (0.0, T), METHOD, q0=q0, v0=v0, rtol=RTOL, atol=RTOL * 1e-2,
-                   n_output=int(T * fs) * sub + 1)
+                   n_output=int(T * fs) * sub + 1, record_steps=True)
     t_acc = res.t[::sub]
     Vel = res.velocities()
     acc_y = np.gradient(Vel[f"{veh.car_body}.vy [m/s]"].to_numpy()[::sub], t_acc)
@@ -689,6 +711,10 @@ def irregular_case(case):
     # carries the wheelsets' bounce are samples of that oscillation, not a statistic
     H = contact_history(veh.model, res)
     H = H[H["t [s]"] >= t_skip]
+    # the unfiltered extremes and wheel lift from every accepted step (railway.assessment.
+    # wheel_event_statistics), not from the 1 kHz samples of the bounce
+    Hs = contact_history(veh.model, res, at="steps")
+    E = wheel_event_statistics(Hs[Hs["t [s]"] >= t_skip], warn=False)
     Q0 = D.total_mass * GRAVITY / 8.0
     try:
         W = wheel_force_statistics(H)
@@ -705,8 +731,9 @@ def irregular_case(case):
            "car body vertical acceleration max [m/s2]": float(np.max(np.abs(acc_z[keep]))),
            "Q high, 20 Hz [N]": float(W["Q high [N]"].max()), "Q low, 20 Hz [N]": float(W["Q low [N]"].min()),
            "dQ/Q0 high, 20 Hz [-]": float((Q0 - W["Q low [N]"].min()) / Q0),
-           "Q max, unfiltered [N]": float(W["Q max, unfiltered [N]"].max()),
-           "Q min, unfiltered [N]": float(W["Q min, unfiltered [N]"].min()),
+           "Q max, unfiltered [N]": float(E["Q max [N]"].max()),
+           "Q min, unfiltered [N]": float(E["Q min [N]"].min()),
+           "wheels lifted": int((E["lifts"] > 0).sum()), "lifted, longest wheel [s]": float(E["lifted [s]"].max()),
            "|Y| high, 20 Hz [N]": float(W["|Y| high [N]"].max()),
            "(Y/Q) 2 m high [-]": float(W["(Y/Q) 2 m high [-]"].max()),
            "(sum Y) 2 m high [N]": float(W["(sum Y) 2 m high [N]"].max()), "n_rhs": res.counters["n_rhs"],
@@ -750,8 +777,10 @@ def _run_irregular(ctx):
         f"evaluated as a track test does (EN 14363 / UIC 518 processing as quoted second-hand, "
         f"railway.assessment): Q low-pass 20 Hz, its 99.85 % ('high') and 0.15 % ('low') percentiles "
         f"over the wheels; |Y| at 20 Hz, 99.85 %; Y/Q and sum Y as 2 m sliding means every 0.5 m, "
-        f"99.85 %. The unfiltered extremes of Q are listed too: they are samples of the bounce and "
-        f"change from run to run with the rounding (README, Railway vehicles).")
+        f"99.85 %. The unfiltered extremes of Q and the wheel lift (Q = 0) are taken from every accepted "
+        f"step of the run (railway.assessment.wheel_event_statistics), not from the 1 kHz outputs; the "
+        f"extremes are peaks of the bounce and change from run to run with the rounding (README, "
+        f"Railway vehicles).")
     return dict(tables={"irregular_track": _units(table)}, figures={"carbody_acceleration_spectra": fig}, notes=notes)
 
 

@@ -975,7 +975,8 @@ def describe_failure(kind, state) -> str:
                     f"nominal height, limit {st.e.max_drop * 1e3:g} mm); wheel {wheel!r}: last Y/Q "
                     f"{row[ST_YQ0]:.3g} at the previous accepted step, {row[ST_YQ1]:.3g} now")
         if code == FAIL_OFF_TRACK:
-            return f"wheelset {st.wheelset_names[i]!r} ({st.name}) is no longer over the track"
+            s_prev = _state_views(state, e, st.n_ws)[1]
+            return st.off_track_message(i, np.full(3, np.nan), float(s_prev[i]))
     return ""
 
 
@@ -1040,6 +1041,9 @@ def compile_wheel_rail(kind, layout) -> CompiledForces:
         if st.spin is not None:
             raise NotCompilable(f"wheel-rail contact {st.name!r}: the nominal-spin formulation (for linear "
                                 "analyses) runs on the numpy path only")
+        if st.cf.reduced:
+            raise NotCompilable(f"wheel-rail contact {st.name!r}: the reduced contact forces (switched off: "
+                                f"{st.cf.reduced}) run on the numpy path only")
         if st.cf._model_code is None:
             raise NotCompilable(f"wheel-rail contact {st.name!r}: creep law {st.cf.creep_law!r} has no "
                                 "compiled form (user laws and join='raw' run on the numpy path)")

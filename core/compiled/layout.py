@@ -69,7 +69,7 @@ from .protocol import (
     resolve_kernel,
 )
 
-__all__ = ["Layout", "CompiledModel", "CompiledData", "compile_model", "KIND_CAPACITY"]
+__all__ = ["Layout", "CompiledModel", "CompiledData", "compile_model", "KIND_CAPACITY", "numpy_refusal"]
 
 #: Kernel tuples are padded with no-ops to this length (a tuple's length is part of its numba
 #: type), so the compiled code is compiled once for every model; a model with more kinds of one
@@ -549,3 +549,22 @@ def _kernel_tuples(ckinds, fkinds) -> tuple[dict, np.ndarray]:
                   frc_ix=frc_ix, frc_io=frc_io, frc_iw=frc_iw, frc_jac=frc_jac, frc_has_jac=frc_has_jac,
                   frc_acc=frc_acc, frc_stateful=frc_stateful, st_off=st_off, st_n=st_n, st_w=st_w)
     return fields, states
+
+
+def numpy_refusal(system, t, q, v) -> str:
+    """The message of the refusal the numpy path raises at ``(t, q, v)`` ('' if it evaluates).
+
+    A force kernel that refuses a state without recording why (``ELEMENT_FAILED``, e.g. a
+    rolling speed below a creep law's limit) leaves only a status code; the compiled
+    integrators then evaluate the numpy elements at the failing state (stateful kinds' search
+    state reset there by ``system.begin_run``) and pass on the element's own message, so both
+    paths end with the same words.  A failure path: one numpy evaluation per failed run.
+    """
+    from ..errors import RUN_FAILURES, MbsuiteError
+
+    try:
+        system.begin_run(float(t), np.asarray(q, float), np.asarray(v, float))
+        system.Q(float(t), np.asarray(q, float), np.asarray(v, float))
+    except (MbsuiteError, ValueError, *RUN_FAILURES) as exc:  # the refusal's own words
+        return str(exc)
+    return ""

@@ -276,10 +276,11 @@ class Integrator:
             self._largest_local = (eps, self.t)
         return None
 
-    def advance(self, t_target: float) -> str | None:
+    def advance(self, t_target: float, max_steps: int | None = None) -> str | None:
         """Advance towards ``t_target``; the default takes one :meth:`step` (may pass ``t_target``).
 
-        Methods with ``steps_to_output = True`` take as many steps as needed and land on
+        Methods with ``steps_to_output = True`` take as many steps as needed (at most
+        ``max_steps``; ``simulate(..., record_steps=True)`` passes 1) and land on
         ``min(t_target, t_end)`` exactly.
         """
         return self.step()

@@ -842,7 +842,7 @@ class CompiledRadau(Integrator):
         st = self._evaluate(self.t, self._y, self._rw.f)
         if st != _p.OK:
             raise InputError(f"{self.name}: right-hand side fails at the initial state of {system.name!r}: "
-                             f"{self._status_message(st)}")
+                             f"{self._status_message(st, (self.t, self._y))}")
         self._h_abs = min(self.h, self.t_bound - self.t) if self.h is not None else self._initial_step()
         self._corr = None
         self._sync()
@@ -894,7 +894,13 @@ class CompiledRadau(Integrator):
         return int(_eval_rhs(self._cd, self._states, self._ws, float(t), y, self.alpha, self.beta, out, self._rw.lam,
                              self._cnt))
 
-    def _status_message(self, code) -> str:
+    def _status_message(self, code, state=None) -> str:
+        """The failure of a kernel status code in the words of the element that reported it.
+
+        The kind's ``describe_failure`` of its state rows; failing that, for ``ELEMENT_FAILED``,
+        the refusal of the numpy element at ``state = (t, y)`` (:func:`core.compiled.layout.
+        numpy_refusal`); failing both, the generic status text after the element's name.
+        """
         why = _p.STATUS_MESSAGES.get(code, f"kernel status {code}")
         err = self._ws.err
         if code not in (_p.SINGULAR, _p.NONFINITE, _p.PROJECTION) and err[2] in (1, 2):
@@ -902,8 +908,19 @@ class CompiledRadau(Integrator):
             why = f"{self._cm.element_name(family, int(err[0]), int(err[1]))}: {why}"
             if err[2] == 1:
                 more = self._cm.failure_description(int(err[0]), self._states)
-                if more:
-                    why = f"{why}: {more}"
+                if not more and code == _p.ELEMENT_FAILED and state is not None:
+                    # the kernel kept no words: the numpy element's own refusal at that state (the
+                    # first of several candidate states that draws one)
+                    nq = self.system.n_q
+                    for t_s, y_s in ([state] if np.ndim(state[0]) == 0 else zip(*state)):
+                        more = _l.numpy_refusal(self.system, t_s, y_s[:nq], y_s[nq:])
+                        if more:
+                            break
+                    element = self._cm.element_name(family, int(err[0]), int(err[1]))
+                    if more and element in more:
+                        return more
+                if more:  # the element's own words replace the generic status text
+                    return f"{self._cm.element_name(family, int(err[0]), int(err[1]))}: {more}"
         return why
 
     def _initial_step(self):
@@ -986,7 +1003,15 @@ class CompiledRadau(Integrator):
             why = (f"coordinate projection did not reach ‖Φ‖ ≤ {self.projection_tol:g} in "
                    f"{self.max_projection_iter} iterations at t = {info[3]:.6g} s")
         else:
-            why = f"{self._status_message(code)} (in the step to t = {info[3]:.6g} s)"
+            # the Newton iterate that failed is not kept: the numpy element is asked at the last
+            # accepted state, then along its tangent over the attempted step (where the failing
+            # condition, e.g. a vanishing rolling speed, lies)
+            h = max(float(self._h_abs), 1e-12)
+            qd = self.system.qdot(self.q, self.v)
+            ts = [self.t + k * h / 4.0 for k in range(5)]
+            ys = [np.concatenate([self.system.normalize(self.q + (t_k - self.t) * qd), self.v + (t_k - self.t) * self.a])
+                  for t_k in ts]
+            why = f"{self._status_message(code, (ts, ys))} (in the step to t = {info[3]:.6g} s)"
         self.status = STATUS_FAILED
         self.t = max(t_before, self.t)
         self.message = f"{self.name} failed at t = {self.t:.6g} s: {why}"

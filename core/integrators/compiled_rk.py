@@ -381,7 +381,7 @@ class CompiledRK(Integrator):
         st = self._evaluate(self.t, self._y, self._f)
         if st != _p.OK:
             raise InputError(f"{self.name}: right-hand side fails at the initial state of {system.name!r}: "
-                             f"{self._status_message(st)}")
+                             f"{self._status_message(st, (self.t, self._y))}")
         if self.h is not None:
             self._h_abs = min(self.h, self.t_bound - self.t)
         else:
@@ -404,8 +404,13 @@ class CompiledRK(Integrator):
         code = self._advance_kernel(float(t), y, out, True, float(t), 0)
         return _p.OK if code in (EXIT_REACHED, EXIT_MAX_STEPS) else code
 
-    def _status_message(self, code) -> str:
-        """The failure of a kernel status code, naming the element that reported it."""
+    def _status_message(self, code, state=None) -> str:
+        """The failure of a kernel status code in the words of the element that reported it.
+
+        The kind's ``describe_failure`` of its state rows; failing that, for ``ELEMENT_FAILED``,
+        the refusal of the numpy element at ``state = (t, y)`` (:func:`core.compiled.layout.
+        numpy_refusal`); failing both, the generic status text after the element's name.
+        """
         why = _p.STATUS_MESSAGES.get(code, f"kernel status {code}")
         err = self._ws.err
         if code not in (_p.SINGULAR, _p.NONFINITE, _p.PROJECTION) and err[2] in (1, 2):
@@ -413,8 +418,19 @@ class CompiledRK(Integrator):
             why = f"{self._cm.element_name(family, int(err[0]), int(err[1]))}: {why}"
             if err[2] == 1:
                 more = self._cm.failure_description(int(err[0]), self._states)
-                if more:
-                    why = f"{why}: {more}"
+                if not more and code == _p.ELEMENT_FAILED and state is not None:
+                    # the kernel kept no words: the numpy element's own refusal at that state (the
+                    # first of several candidate states that draws one)
+                    nq = self.system.n_q
+                    for t_s, y_s in ([state] if np.ndim(state[0]) == 0 else zip(*state)):
+                        more = _l.numpy_refusal(self.system, t_s, y_s[:nq], y_s[nq:])
+                        if more:
+                            break
+                    element = self._cm.element_name(family, int(err[0]), int(err[1]))
+                    if more and element in more:
+                        return more
+                if more:  # the element's own words replace the generic status text
+                    return f"{self._cm.element_name(family, int(err[0]), int(err[1]))}: {more}"
         return why
 
     def _initial_step(self, order):
@@ -492,7 +508,9 @@ class CompiledRK(Integrator):
             why = (f"coordinate projection did not reach ‖Φ‖ ≤ {self.projection_tol:g} in "
                    f"{self.max_projection_iter} iterations at t = {info[3]:.6g} s")
         else:
-            why = f"{self._status_message(code)} (in the step to t = {info[3]:.6g} s)"
+            # the right-hand side that failed was evaluated at (info[3], tmp): the stage state
+            why = (f"{self._status_message(code, (float(info[3]), self._tmp.copy()))} "
+                   f"(in the step to t = {info[3]:.6g} s)")
         self.status = STATUS_FAILED
         self.message = f"{self.name} failed at t = {self.t:.6g} s: {why}"
         return self.message

@@ -180,67 +180,35 @@ def _run_flying(ctx):
 # =============================================================================================
 # 2. critical speed
 # =============================================================================================
-def _hunting_mode(model):
-    """(real, imag) of the least damped hunting eigenvalue of a suspended wheelset model."""
-    import warnings
-
-    from core.analysis import AnalysisWarning, eigen
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", AnalysisWarning)
-        tab, modes = eigen(model, model.q0, model.v0, 0.0)
-    best = (-np.inf, np.nan)
-    for i in tab.index:
-        dom = modes[f"mode {i}"].abs().idxmax()
-        if dom in ("wheelset.vy [m/s]", "wheelset.wz [rad/s]") and tab.loc[i, "imag [rad/s]"] > 1.0:
-            if tab.loc[i, "real [1/s]"] > best[0]:
-                best = (float(tab.loc[i, "real [1/s]"]), float(tab.loc[i, "imag [rad/s]"]))
-    return best
-
-
 def linear_critical_speed(k_y=3e5, k_psi=3e5, xtol=1e-3):
-    """The suspended wheelset (cone 1:40, Kalker linear): core's eigenvalue critical speed
-    (bisection on the sign of the hunting mode's real part) and the closed form with the
-    equivalent conicity, the rolling of the wheelset and the gyroscopic term.  Returns a dict."""
+    """The suspended wheelset (cone 1:40, Kalker linear), like for like.
+
+    Core's eigenvalue critical speed of the multibody wheelset (Brent's method on the real part
+    of the hunting mode), the same wheelset with the terms the classical two-degree-of-freedom
+    model neglects switched off (:data:`railway.wheelset_models.TEXTBOOK`), and the closed forms
+    of :class:`railway.hunting.LinearWheelset` from the rigid contact geometry and Hertz: complete
+    (every term of :data:`railway.hunting.TERMS`) and classical (none).  Returns a dict.
+    """
     from scipy.optimize import brentq
 
-    from core.contact_laws import hertz_from_load
-
-    from .contact_geometry import contact_geometry_table, rigid_contact
-    from .creep import kalker_coefficients
-    from .hunting import suspended_wheelset_critical_speed
+    from .hunting import TERMS
     from .two_point import conical_wheel
-    from .wheelset_models import WHEELSET, suspended_wheelset
+    from .wheelset_models import TEXTBOOK, eigen_critical_speed, hunting_mode, linear_wheelset, suspended_wheelset
 
     cone = conical_wheel()
 
     def real(V):
-        return _hunting_mode(suspended_wheelset(V, k_y, k_psi, wheel=cone, nominal_spin=True))[0]
+        return hunting_mode(suspended_wheelset(V, k_y, k_psi, wheel=cone, nominal_spin=True))[0]
 
     V_core = brentq(real, 20.0, 120.0, xtol=xtol)
-    w_core = _hunting_mode(suspended_wheelset(V_core, k_y, k_psi, wheel=cone, nominal_spin=True))[1]
-    # closed-form inputs, independent of the dynamic model: rigid contact geometry and Hertz
-    tab = contact_geometry_table(np.linspace(-0.001, 0.001, 21), wheel=cone)
-    lam = float(np.polyfit(tab["y [m]"], tab["delta_r [m]"], 1)[0] / 2.0)
-    rho = float(np.polyfit(tab["y [m]"], tab["roll [rad]"], 1)[0])
-    _, _, res, act = rigid_contact([0.0], wheel=cone)
-    i, c = np.arange(2), act[0]
-    Ac = 0.5 * (res.k_wheel_rolling + res.k_rail_rolling)[i, c]
-    Bc = 0.5 * (res.k_wheel_lateral + res.k_rail_lateral)[i, c]
-    E, nu = 2.1e11, 0.28
-    W = WHEELSET["mass"] * 9.81 / 2.0
-    h = hertz_from_load(W / np.cos(res.contact_angle[i, c]), Ac, Bc, E, nu, E, nu)
-    C11, C22, _, _ = kalker_coefficients(h.a / h.b, nu)
-    G = E / (2.0 * (1.0 + nu))
-    f11, f22 = float(np.mean(G * h.a * h.b * C11)), float(np.mean(G * h.a * h.b * C22))
-    l = 0.5 * abs(res.point_wheel[0, c[0], 1] - res.point_wheel[1, c[1], 1])
-    r0 = float(res.rolling_radius[0, c[0]])
-    m, I, Iy = WHEELSET["mass"], WHEELSET["inertia"][2], WHEELSET["inertia"][1]
-    V_cf, w_cf = suspended_wheelset_critical_speed(m, I, k_y, k_psi, f11, f22, l, r0, lam,
-                                                   spin_inertia=Iy, roll_per_lateral=rho)
-    V_plain, w_plain = suspended_wheelset_critical_speed(m, I, k_y, k_psi, f11, f22, l, r0, 1.0 / 40.0)
-    return dict(V_core=V_core, w_core=w_core, V_cf=V_cf, w_cf=w_cf, V_plain=V_plain, w_plain=w_plain,
-                lam=lam, rho=rho, f11=f11, f22=f22, l=l, r0=r0, k_y=k_y, k_psi=k_psi, real=real)
+    w_core = hunting_mode(suspended_wheelset(V_core, k_y, k_psi, wheel=cone, nominal_spin=True))[1]
+    V_tb, w_tb = eigen_critical_speed(k_y, k_psi, (20.0, 120.0), wheel=cone, xtol=xtol, **TEXTBOOK)
+    lw = linear_wheelset(k_y, k_psi, wheel=cone)
+    V_cf, w_cf = lw.critical_speed()
+    V_plain, w_plain = lw.critical_speed(**{t: False for t in TERMS})
+    return dict(V_core=V_core, w_core=w_core, V_textbook=V_tb, w_textbook=w_tb, V_cf=V_cf, w_cf=w_cf,
+                V_plain=V_plain, w_plain=w_plain, lam=lw.conicity, rho=lw.roll_per_lateral, f11=lw.f11,
+                f22=lw.f22, l=lw.l, r0=lw.r0, k_y=k_y, k_psi=k_psi, real=real)
 
 
 def run_down(law, V0=90.0, V1=40.0, rate=2.0, kick=0.008, definition=None, n_output_per_s=100,
@@ -308,14 +276,21 @@ def _run_critical(ctx):
     lin = linear_critical_speed()
     rows_lin = [{"quantity": "critical speed, eigenvalues of core's linearisation", "value": lin["V_core"],
                  "unit": "m/s"},
-                {"quantity": "critical speed, closed form (equivalent conicity, roll, gyroscopic term)",
+                {"quantity": "critical speed, complete linear wheelset (closed form, every term)",
                  "value": lin["V_cf"], "unit": "m/s"},
                 {"quantity": "difference", "value": lin["V_core"] / lin["V_cf"] - 1.0, "unit": "-"},
-                {"quantity": "critical speed, classical closed form (cone 1:40, no gyroscopic term)",
+                {"quantity": "critical speed, eigenvalues, classical model's terms only (TEXTBOOK)",
+                 "value": lin["V_textbook"], "unit": "m/s"},
+                {"quantity": "critical speed, classical two-degree-of-freedom closed form",
                  "value": lin["V_plain"], "unit": "m/s"},
+                {"quantity": "difference (classical)", "value": lin["V_textbook"] / lin["V_plain"] - 1.0, "unit": "-"},
                 {"quantity": "hunting frequency at V_c, eigenvalues", "value": lin["w_core"] / (2 * np.pi),
                  "unit": "Hz"},
-                {"quantity": "hunting frequency at V_c, closed form", "value": lin["w_cf"] / (2 * np.pi),
+                {"quantity": "hunting frequency at V_c, complete closed form", "value": lin["w_cf"] / (2 * np.pi),
+                 "unit": "Hz"},
+                {"quantity": "hunting frequency, eigenvalues (TEXTBOOK)", "value": lin["w_textbook"] / (2 * np.pi),
+                 "unit": "Hz"},
+                {"quantity": "hunting frequency, classical closed form", "value": lin["w_plain"] / (2 * np.pi),
                  "unit": "Hz"},
                 {"quantity": "equivalent conicity (rigid table)", "value": lin["lam"], "unit": "-"},
                 {"quantity": "roll per lateral displacement (rigid table)", "value": lin["rho"], "unit": "rad/m"},
@@ -331,17 +306,16 @@ def _run_critical(ctx):
     fig, ax = _fig(size=(7, 3.8))
     ax = ax[0, 0]
     ax.plot(Vg, re_core, "o-", label="core: eigenvalues of the linearised model")
-    from .hunting import suspended_wheelset_matrices
-    from .wheelset_models import WHEELSET
+    from .two_point import conical_wheel
+    from .wheelset_models import linear_wheelset
 
+    lw = linear_wheelset(lin["k_y"], lin["k_psi"], wheel=conical_wheel())
     re_cf = []
     for V in Vg:
-        M, C, K = suspended_wheelset_matrices(V, WHEELSET["mass"], WHEELSET["inertia"][2], lin["k_y"], lin["k_psi"],
-                                              lin["f11"], lin["f22"], lin["l"], lin["r0"], lin["lam"],
-                                              spin_inertia=WHEELSET["inertia"][1], roll_per_lateral=lin["rho"])
+        M, C, K = lw.matrices(V)
         Am = np.block([[np.zeros((2, 2)), np.eye(2)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
         re_cf.append(float(np.max(np.linalg.eigvals(Am).real)))
-    ax.plot(Vg, re_cf, "--", label="closed form (2 dof, railway.hunting)")
+    ax.plot(Vg, re_cf, "--", label="complete linear wheelset (closed form, railway.hunting)")
     ax.axhline(0.0, c="k", lw=0.8)
     ax.set(xlabel="speed V [m/s]", ylabel="real part of the hunting eigenvalue [1/s]",
            title=f"railway-critical-speed — wheelset on springs (k_y = {lin['k_y']:.3g} N/m, k_psi = "
@@ -411,13 +385,15 @@ def _run_critical(ctx):
         f"Linear: a wheelset with conical wheels (1:40) held by a lateral spring and a yaw spring (two "
         f"longitudinal springs at ±1 m) to a frame driven at V, Kalker linear creep. Core's `linearize`/"
         f"`eigen` about steady running in the non-rotating wheelset formulation (nominal spin, "
-        f"railway.wheel_rail) give V_c = {lin['V_core']:.3f} m/s (bisection on the sign of the hunting "
-        f"eigenvalue's real part to 1 mm/s); the closed form of railway.hunting with the equivalent "
-        f"conicity {lin['lam']:.5f} and roll {lin['rho']:.5f} rad/m of the rigid contact-geometry table, "
-        f"Hertz creep coefficients at the static load and the gyroscopic yaw moment gives "
-        f"{lin['V_cf']:.3f} m/s ({(lin['V_core'] / lin['V_cf'] - 1) * 100:+.2f} %; what remains is the spin "
-        f"creep and the creep and gravitational stiffnesses the two-degree-of-freedom model leaves out). "
-        f"The classical formula with the nominal cone and without the gyroscopic term: {lin['V_plain']:.3f} m/s. "
+        f"railway.wheel_rail) give V_c = {lin['V_core']:.3f} m/s (Brent's method on the hunting "
+        f"eigenvalue's real part to 1 mm/s); the complete linear wheelset of railway.hunting "
+        f"(LinearWheelset: equivalent conicity {lin['lam']:.5f} and roll {lin['rho']:.5f} rad/m of the "
+        f"rigid contact-geometry table, Hertz creep coefficients at the static load, gyroscopic moment, "
+        f"roll-rate creepage, gravitational stiffness, contact angle, spin creepage) gives "
+        f"{lin['V_cf']:.3f} m/s ({(lin['V_core'] / lin['V_cf'] - 1) * 100:+.3f} %). Like for like with the "
+        f"classical two-degree-of-freedom model: the multibody wheelset with those five terms switched off "
+        f"(railway.wheelset_models.TEXTBOOK) gives {lin['V_textbook']:.3f} m/s against the classical closed "
+        f"form's {lin['V_plain']:.3f} m/s ({(lin['V_textbook'] / lin['V_plain'] - 1) * 100:+.4f} %). "
         f"A linearisation of the absolute (spinning) formulation is not valid: its body frames turn with "
         f"the spin, so it is the snapshot of a periodic system.\n\n"
         f"Nonlinear: the Manchester coach (stand-in for the ML95 trailer) on straight track, all wheelsets "

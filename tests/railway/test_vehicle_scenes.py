@@ -52,11 +52,16 @@ def test_klingel_wavelength_of_a_free_conical_wheelset():
 
 
 def test_suspended_wheelset_critical_speed_eigenvalues_against_closed_form():
-    """Core's linearisation (non-rotating wheelset formulation) against the closed form with the
-    equivalent conicity, roll and gyroscopic term: within 1 % (measured +0.92 %)."""
+    """Core's linearisation (non-rotating wheelset formulation) like for like: against the complete
+    linear wheelset (measured -0.012 % in V_c, -0.018 % in frequency; tolerance 2.5e-4, the largest
+    deviation at this cone rounded up as in tests/railway/test_hunting_like_for_like.py) and, with
+    the classical model's neglected terms switched off, against the classical closed form
+    (+0.0030 %, 3e-7; tolerance 1.2e-4 and 2.5e-6)."""
     lin = linear_critical_speed()
-    assert lin["V_core"] == pytest.approx(lin["V_cf"], rel=1e-2)
-    assert lin["w_core"] == pytest.approx(lin["w_cf"], rel=1e-2)
+    assert lin["V_core"] == pytest.approx(lin["V_cf"], rel=2.5e-4)
+    assert lin["w_core"] == pytest.approx(lin["w_cf"], rel=2.5e-4)
+    assert lin["V_textbook"] == pytest.approx(lin["V_plain"], rel=1.2e-4)
+    assert lin["w_textbook"] == pytest.approx(lin["w_plain"], rel=2.5e-6)
     # the hunting eigenvalue changes sign there: stable 1 % below, unstable 1 % above
     assert lin["real"](0.99 * lin["V_core"]) < 0 < lin["real"](1.01 * lin["V_core"])
 

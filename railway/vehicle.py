@@ -293,24 +293,7 @@ class Vehicle:
         kind = static.contact_kind
         kind.reset_state(bs, 0.0)
         out = kind.contact_outputs(bs, 0.0)
-        share = self.definition.total_mass * GRAVITY / 8.0
-        Qw = out["wheels"]["Q [N]"]
-        table = pd.DataFrame({"wheel": static.wheel_names, "Q [N]": Qw, "share m g / 8 [N]": share,
-                              "relative difference [-]": Qw / share - 1.0})
-        rows = []
-        for k in m.force_kinds:
-            if type(k).__name__ != "BushingKind":
-                continue
-            o = k.outputs(bs, 0.0)
-            for i, nm in enumerate(k.names):
-                rows.append({"element": nm, "dx [m]": o["dx [m]"][i], "dy [m]": o["dy [m]"][i],
-                             "dz [m]": o["dz [m]"][i], "Fx [N]": o["Fx [N]"][i], "Fy [N]": o["Fy [N]"][i],
-                             "Fz [N]": o["Fz [N]"][i], "My [N m]": o["My [N m]"][i]})
-        table.attrs["deflections"] = pd.DataFrame(rows)
-        table.attrs["equilibrium"] = eq
-        self.q_static = eq.q
-        self.preload_table = table
-        return table
+        return self._preload_report(m, bs, static.wheel_names, out["wheels"]["Q [N]"], eq.q, eq)
 
     def _preload_in_curve(self, tol):
         """:meth:`preload` in a curve or transition: the quasi-static curving state at the
@@ -321,9 +304,15 @@ class Vehicle:
         st = self.start
         m = self.model
         bs = m.body_states(st.q, st.v)
+        return self._preload_report(m, bs, self.wheel_names, st.wheels["Q [N]"].to_numpy(), st.q, st)
+
+    def _preload_report(self, m, bs, wheel_names, Qw, q, equilibrium):
+        """The preload table (wheel loads against m_total g / 8; ``attrs["deflections"]``: every
+        Bushing's deflections and forces) of the state ``bs`` of model ``m``; keeps ``q`` as the
+        start of the dynamic runs."""
         share = self.definition.total_mass * GRAVITY / 8.0
-        Qw = st.wheels["Q [N]"].to_numpy()
-        table = pd.DataFrame({"wheel": self.wheel_names, "Q [N]": Qw, "share m g / 8 [N]": share,
+        Qw = np.asarray(Qw, dtype=float)
+        table = pd.DataFrame({"wheel": wheel_names, "Q [N]": Qw, "share m g / 8 [N]": share,
                               "relative difference [-]": Qw / share - 1.0})
         rows = []
         for k in m.force_kinds:
@@ -335,8 +324,8 @@ class Vehicle:
                              "dz [m]": o["dz [m]"][i], "Fx [N]": o["Fx [N]"][i], "Fy [N]": o["Fy [N]"][i],
                              "Fz [N]": o["Fz [N]"][i], "My [N m]": o["My [N m]"][i]})
         table.attrs["deflections"] = pd.DataFrame(rows)
-        table.attrs["equilibrium"] = st
-        self.q_static = st.q
+        table.attrs["equilibrium"] = equilibrium
+        self.q_static = q
         self.preload_table = table
         return table
 

@@ -568,3 +568,35 @@ def numpy_refusal(system, t, q, v) -> str:
     except (MbsuiteError, ValueError, *RUN_FAILURES) as exc:  # the refusal's own words
         return str(exc)
     return ""
+
+
+def status_message(cm, system, err, states, code, state=None) -> str:
+    """The failure of a kernel status code in the words of the element that reported it.
+
+    The kind's ``describe_failure`` of its state rows; failing that, for ``ELEMENT_FAILED``,
+    the refusal of the numpy element at ``state = (t, y)`` or at the first of several candidate
+    states ``(ts, ys)`` that draws one (:func:`numpy_refusal`); failing both, the generic status
+    text after the element's name.  ``err`` is the workspace's error record (element index, row,
+    family 1 = force, 2 = constraint); shared by the compiled explicit and implicit integrators.
+    """
+    from . import protocol as _p
+
+    why = _p.STATUS_MESSAGES.get(code, f"kernel status {code}")
+    if code in (_p.SINGULAR, _p.NONFINITE, _p.PROJECTION) or err[2] not in (1, 2):
+        return why
+    family = "force" if err[2] == 1 else "constraint"
+    element = cm.element_name(family, int(err[0]), int(err[1]))
+    why = f"{element}: {why}"
+    if err[2] != 1:
+        return why
+    more = cm.failure_description(int(err[0]), states)
+    if not more and code == _p.ELEMENT_FAILED and state is not None:
+        # the kernel kept no words: the numpy element's own refusal at that state
+        nq = system.n_q
+        for t_s, y_s in ([state] if np.ndim(state[0]) == 0 else zip(*state)):
+            more = numpy_refusal(system, t_s, y_s[:nq], y_s[nq:])
+            if more:
+                break
+        if more and element in more:
+            return more
+    return f"{element}: {more}" if more else why

@@ -405,33 +405,9 @@ class CompiledRK(Integrator):
         return _p.OK if code in (EXIT_REACHED, EXIT_MAX_STEPS) else code
 
     def _status_message(self, code, state=None) -> str:
-        """The failure of a kernel status code in the words of the element that reported it.
-
-        The kind's ``describe_failure`` of its state rows; failing that, for ``ELEMENT_FAILED``,
-        the refusal of the numpy element at ``state = (t, y)`` (:func:`core.compiled.layout.
-        numpy_refusal`); failing both, the generic status text after the element's name.
-        """
-        why = _p.STATUS_MESSAGES.get(code, f"kernel status {code}")
-        err = self._ws.err
-        if code not in (_p.SINGULAR, _p.NONFINITE, _p.PROJECTION) and err[2] in (1, 2):
-            family = "force" if err[2] == 1 else "constraint"
-            why = f"{self._cm.element_name(family, int(err[0]), int(err[1]))}: {why}"
-            if err[2] == 1:
-                more = self._cm.failure_description(int(err[0]), self._states)
-                if not more and code == _p.ELEMENT_FAILED and state is not None:
-                    # the kernel kept no words: the numpy element's own refusal at that state (the
-                    # first of several candidate states that draws one)
-                    nq = self.system.n_q
-                    for t_s, y_s in ([state] if np.ndim(state[0]) == 0 else zip(*state)):
-                        more = _l.numpy_refusal(self.system, t_s, y_s[:nq], y_s[nq:])
-                        if more:
-                            break
-                    element = self._cm.element_name(family, int(err[0]), int(err[1]))
-                    if more and element in more:
-                        return more
-                if more:  # the element's own words replace the generic status text
-                    return f"{self._cm.element_name(family, int(err[0]), int(err[1]))}: {more}"
-        return why
+        """The failure of a kernel status code in the words of the element that reported it
+        (:func:`core.compiled.layout.status_message`)."""
+        return _l.status_message(self._cm, self.system, self._ws.err, self._states, code, state)
 
     def _initial_step(self, order):
         """Initial step of Hairer, Nørsett & Wanner I, Sec. II.4 (scipy's ``select_initial_step``)."""

@@ -14,7 +14,10 @@ Public API (simple signatures; the train and circuit scenes call these)::
         contiguous intervals where the signal n(t) is beyond the level
     time_above_limits(loads, limits=None, sections=None) -> DataFrame
         per limit row (and per track section): peak, number of exceedances, total and longest
-        time beyond the level, verdict against the allowed duration
+        time beyond the level, verdict against the allowed duration -- read from the output
+        grid (moves with the output step; warns GridResolutionWarning where it cannot resolve);
+        coaster.train.time_above_limits_dense(run, limits, sections) gives the same table from
+        the run's dense solution
 
 **Load factor.**  The rider sits at the body-fixed point P of the car body (ρ′ in body
 coordinates, ρ = A ρ′).  With the car's centre-of-mass acceleration a = r̈, its angular
@@ -50,7 +53,9 @@ envelopes of level against duration.  ``data/coaster/acceleration_limits.csv`` h
 envelope as data (second-hand numbers, see the file's source line and data/coaster/README.md):
 each row is an axis, a signed level and the longest contiguous time allowed beyond it.
 :func:`time_above_limits` measures every contiguous exceedance (crossing times by linear
-interpolation between output samples), not only the peaks.
+interpolation between output samples), not only the peaks; :func:`coaster.train.time_above_limits_dense`
+locates the crossings on the run's dense solution (re-integrated states, Newton on the load
+factor with its rate along the flow) and finds exceedances between two outputs.
 
 References
 ----------
@@ -68,6 +73,7 @@ Design 45(4):470-500 (rider accelerations from the multibody model).
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -76,6 +82,7 @@ import pandas as pd
 from core import frames
 from core.dynamics import accelerations
 from core.errors import DataFileError, InputError
+from core.signals import GridResolutionWarning, hidden_extremes
 
 __all__ = [
     "LIMITS_FILE",
@@ -394,7 +401,17 @@ def _section_runs(labels):
 
 
 def time_above_limits(loads, limits=None, sections=None, time_column="t [s]"):
-    """Time spent beyond each level of an acceleration envelope, per axis and per track section.
+    """Time spent beyond each level of an acceleration envelope, per axis and per track section,
+    read from the output grid.
+
+    **Grid-based**: the durations move with the output step (crossings interpolated linearly
+    between outputs, error O(h²)) and an exceedance shorter than the output step, between two
+    outputs, is missed.  When ``loads`` carries the jerk columns (:func:`rider_loads`), output
+    intervals whose slopes change sign with tangents reaching the level (an extreme between the
+    outputs that may pass it: :func:`core.signals.hidden_extremes`) are counted and a
+    :class:`core.signals.GridResolutionWarning` is issued.  For a train run, use
+    :func:`coaster.train.time_above_limits_dense` (same table, from the run's dense solution:
+    independent of the output step).
 
     For every limit row (axis, signed level, allowed duration) and every section, the
     contiguous exceedances of the load factor (:func:`exceedances`) give the number of
@@ -448,6 +465,7 @@ def time_above_limits(loads, limits=None, sections=None, time_column="t [s]"):
     runs = _section_runs(list(labels))
     order = list(dict.fromkeys(labels))
     rows = []
+    hidden = 0
     for sec in order:
         for _, lim in limits.iterrows():
             col = f"n_{lim['axis']} [g]"
@@ -456,6 +474,12 @@ def time_above_limits(loads, limits=None, sections=None, time_column="t [s]"):
             level, allowed = float(lim["level [g]"]), float(lim["max duration [s]"])
             n = loads[col].to_numpy(float)
             ex = [exceedances(t[a:b + 1], n[a:b + 1], level) for s_, a, b in runs if s_ == sec and b >= a]
+            jc = f"jerk_{lim['axis']} [g/s]"
+            if jc in loads.columns:  # outputs whose slopes say an extreme between them passes the level
+                j = loads[jc].to_numpy(float)
+                side = "above" if level > 0 else "below"
+                hidden += sum(len(hidden_extremes(t[a:b + 1], n[a:b + 1], j[a:b + 1], level, side))
+                              for s_, a, b in runs if s_ == sec and b > a)
             ex = pd.concat([e for e in ex if len(e)], ignore_index=True) if any(len(e) for e in ex) else None
             sgn = math.copysign(1.0, level)
             if ex is None:
@@ -478,4 +502,10 @@ def time_above_limits(loads, limits=None, sections=None, time_column="t [s]"):
                          "basis": lim.get("basis", "")})
     out = pd.DataFrame(rows)
     out.attrs["source"] = limits.attrs.get("source", "")
+    out.attrs["method"] = "grid-based: exceedances of the output samples, crossings interpolated linearly"
+    if hidden:
+        warnings.warn(f"time_above_limits: {hidden} output intervals may hide an exceedance (or a dip back) between "
+                      "two outputs: their slopes change sign and their tangents reach the level (core.signals."
+                      "hidden_extremes); this table is read from the output grid and does not resolve them: use "
+                      "coaster.train.time_above_limits_dense", GridResolutionWarning, stacklevel=2)
     return out

@@ -126,6 +126,7 @@ __all__ = [
     "rider_peaks",
     "section_extremes",
     "wheel_force_peaks",
+    "time_above_limits_dense",
     "rank_table",
     "circuit_frame",
     "circuit_sections",
@@ -1233,6 +1234,55 @@ def run_train(train: Train, L_start: float, speed: float, L_stop: float, *, chai
                     meta={"method": method, "rtol": rtol, "atol": atol, "output_step": output_step, "chunk": chunk})
 
 
+def _section_labels(run: TrainRun, sections: pd.DataFrame | None):
+    """(period of a closed track or 0, section label of the lead wheelset per output row,
+    section -> (L_start, L_end))."""
+    period = float(run.train.track.length) if getattr(run.train.track, "closed", False) else 0.0
+    if sections is None:
+        return period, np.array(["all"] * len(run.t), dtype=object), {}
+    labels = np.array([_section_at(sections, x, period) for x in run.L[:, 0]], dtype=object)
+    bounds = {str(r["section"]): (float(r["L_start [m]"]), float(r["L_end [m]"])) for _, r in sections.iterrows()}
+    return period, labels, bounds
+
+
+def _boundary_time(t, L1, period, i, Lb, state) -> float:
+    """Time in [t_i, t_i+1] where L_1 (mod period) passes the boundary Lb: linear guess between
+    the outputs, then two Newton steps t <- t - (L_1(t) - Lb)/dL_1/dt on ``state(t) -> (L_1, dL_1/dt)``."""
+    a, b = L1[i], L1[i + 1]
+    if period:
+        Lb = Lb + period * np.floor(min(a, b) / period)
+        if Lb < min(a, b) - 1e-9:
+            Lb += period
+    x = (Lb - a) / (b - a) if b != a else 0.0
+    tc = float(t[i] + np.clip(x, 0.0, 1.0) * (t[i + 1] - t[i]))
+    for _ in range(2):
+        L, Ld = state(tc)
+        if Ld == 0.0:
+            break
+        tc = float(np.clip(tc - (L - Lb) / Ld, t[i], t[i + 1]))
+    return tc
+
+
+def _occurrences(t, L1, labels, bounds, crossing):
+    """Contiguous occurrences of a section: [name, first row, last row, entry time, exit time]
+    (None at the run's ends); a boundary time from ``crossing(i, L_b)`` (the midpoint of the two
+    outputs for a boundary of an unnamed stretch)."""
+    occ = []
+    i0 = 0
+    for i in range(1, len(t) + 1):
+        if i == len(t) or labels[i] != labels[i0]:
+            occ.append([labels[i0], i0, i - 1, None, None])
+            i0 = i
+    for k in range(len(occ) - 1):
+        name, b = occ[k][0], occ[k][2]
+        forward = L1[b + 1] >= L1[b]
+        Lb = bounds.get(occ[k + 1][0] if forward else name, (None,))[0]
+        tc = 0.5 * (t[b] + t[b + 1]) if Lb is None else crossing(b, Lb)
+        occ[k][4] = tc
+        occ[k + 1][3] = tc
+    return occ
+
+
 def section_extremes(run: TrainRun, channels, names, sections: pd.DataFrame | None = None,
                      n_fine: int = 12) -> pd.DataFrame:
     r"""Maximum and minimum of functions of the state per track section, independent of the output step.
@@ -1275,15 +1325,9 @@ def section_extremes(run: TrainRun, channels, names, sections: pd.DataFrame | No
     names = list(names)
     if int(n_fine) < 3:
         raise InputError(f"section_extremes: n_fine must be >= 3, got {n_fine!r}")
-    period = float(run.train.track.length) if getattr(run.train.track, "closed", False) else 0.0
+    period, labels, bounds = _section_labels(run, sections)
     L1 = run.L[:, 0]
     t = run.t
-    if sections is None:
-        labels = np.array(["all"] * len(t), dtype=object)
-        bounds = {}
-    else:
-        labels = np.array([_section_at(sections, x, period) for x in L1], dtype=object)
-        bounds = {str(r["section"]): (float(r["L_start [m]"]), float(r["L_end [m]"])) for _, r in sections.iterrows()}
     cache = {}
 
     def values(times):
@@ -1308,36 +1352,12 @@ def section_extremes(run: TrainRun, channels, names, sections: pd.DataFrame | No
         cache[float(tt)] = (x, float(L1[i]), float(run.Ldot[i, 0]))
 
     def crossing(i, Lb):
-        """Time in [t_i, t_i+1] where L_1 (mod period) passes the boundary Lb."""
-        a, b = L1[i], L1[i + 1]
-        if period:
-            Lb = Lb + period * np.floor(min(a, b) / period)
-            if Lb < min(a, b) - 1e-9:
-                Lb += period
-        x = (Lb - a) / (b - a) if b != a else 0.0
-        tc = float(t[i] + np.clip(x, 0.0, 1.0) * (t[i + 1] - t[i]))
-        for _ in range(2):
-            (_, L, Ld), = values([tc])
-            if Ld == 0.0:
-                break
-            tc = float(np.clip(tc - (L - Lb) / Ld, t[i], t[i + 1]))
+        tc = _boundary_time(t, L1, period, i, Lb, lambda u: values([u])[0][1:])
         values([tc])
         return tc
 
-    occ = []  # contiguous occurrences of a section: [name, first row, last row, entry time, exit time]
-    i0 = 0
-    for i in range(1, len(t) + 1):
-        if i == len(t) or labels[i] != labels[i0]:
-            occ.append([labels[i0], i0, i - 1, None, None])
-            i0 = i
-    for k in range(len(occ) - 1):
-        name, b = occ[k][0], occ[k][2]
-        forward = L1[b + 1] >= L1[b]
-        Lb = bounds.get(occ[k + 1][0] if forward else name, (None,))[0]
-        tc = 0.5 * (t[b] + t[b + 1]) if Lb is None else crossing(b, Lb)
-        values([tc])
-        occ[k][4] = tc
-        occ[k + 1][3] = tc
+    occ = _occurrences(t, L1, labels, bounds, crossing)
+    values([o[4] for o in occ[:-1]])
     out = {}
     for name, a, b, te, tx in occ:
         lo = float(t[a]) if te is None else te
@@ -1445,6 +1465,183 @@ def wheel_force_peaks(run: TrainRun, sections: pd.DataFrame | None = None, n_fin
                         "|F_n| max [kN]": df["|F_n| max"], "t of F_b max [s]": df["t of F_b hi max"],
                         "t of F_b min [s]": df["t of F_b lo min"], "t of |F_n| max [s]": df["t of |F_n| max"]})
     return out
+
+
+class _DenseLoads:
+    """Load factor n (3,) [g] and its rate dn/dt (3,) [g/s] at the rider point at any time of a
+    run, with L_1 and dL_1/dt: outputs from the run's states and accelerations, other times from
+    :meth:`TrainRun.states_at`; the rate is the derivative along the flow (central difference of
+    the index-1 load factor, :mod:`coaster.rider`, eps = ``jerk_step``); cached by time."""
+
+    def __init__(self, run, car, rider_point, jerk_step):
+        from .rider import _Rider
+
+        self.run = run
+        rp = run.train.p.rider_point if rider_point is None else rider_point
+        self.riders = [_Rider(m, car, rp, None) for m in run.models]
+        self.eps = float(jerk_step)
+        self.cache = {}
+        for k in np.unique(run.phase):
+            sel = np.flatnonzero(run.phase == k)
+            self._fill(int(k), run.t[sel], run.q[sel], run.v[sel], run.vdot[sel])
+
+    def _fill(self, k, T, Q, V, A=None):
+        m, r, e = self.run.models[k], self.riders[k], self.eps
+        if A is None:
+            A, _ = _accelerations(m, T, Q, V)
+        Qp = np.array([m.retract(q, e * v) for q, v in zip(Q, V)])
+        Qm = np.array([m.retract(q, -e * v) for q, v in zip(Q, V)])
+        Ap, _ = _accelerations(m, T + e, Qp, V + e * A)
+        Am, _ = _accelerations(m, T - e, Qm, V - e * A)
+        iq, iv = self.run.train.lead_index(m)
+        for j, tt in enumerate(T):
+            n = r.loads_given(Q[j], V[j], A[j])[0]
+            n_p = r.loads_given(Qp[j], V[j] + e * A[j], Ap[j])[0]
+            n_m = r.loads_given(Qm[j], V[j] - e * A[j], Am[j])[0]
+            nd = (n_p - n_m) / (2 * e)
+            self.cache[float(tt)] = (n, nd, float(Q[j, iq]), float(V[j, iv]))
+
+    def __call__(self, tt):
+        tt = float(tt)
+        if tt not in self.cache:
+            ph, Q, V, T = self.run.states_at([tt])
+            self._fill(int(ph[0]), np.array([tt]), Q, V)
+        return self.cache[tt]
+
+
+def time_above_limits_dense(run: TrainRun, limits: pd.DataFrame | None = None, sections: pd.DataFrame | None = None,
+                            car: str = "car1", rider_point=None, peaks: pd.DataFrame | None = None,
+                            xtol: float | None = None, jerk_step: float = 1e-5, warn: bool = True) -> pd.DataFrame:
+    r"""Time spent beyond each acceleration-limit level per track section, from the run's dense solution.
+
+    The same table as :func:`coaster.rider.time_above_limits`, but independent of the output step:
+    per contiguous occurrence of a section (its boundaries located in time as in
+    :func:`section_extremes`) and per limit row (axis, signed level c), the load factor
+    n(t) at the rider point and its rate ṅ(t) (derivative along the flow) are known at the
+    outputs and, through :meth:`TrainRun.states_at` (re-integration from the output before, at
+    the run's tolerance), at any time.  :func:`core.signals.dense_level_intervals` then
+
+    1. searches every output interval whose slopes change sign and whose tangents (Eq. S2 of
+       :mod:`core.signals`) reach the level for its extreme (root of ṅ, Brent): an exceedance
+       that lies entirely between two outputs is found;
+    2. locates every crossing n(t*) = c by a safeguarded Newton iteration t <- t − (n − c)/ṅ
+       to ``xtol`` (default 10 rtol max(1 s, output step));
+
+    the time above is the sum of the located intervals, their number the exceedances.  What it
+    cannot see: two extremes of n within one output step (ṅ changing sign twice between two
+    outputs) — choose the output step below half the shortest period of the load factor.
+
+    Parameters
+    ----------
+    run : TrainRun
+    limits : pandas.DataFrame, optional
+        :func:`coaster.rider.read_acceleration_limits` table; default the shipped file.
+    sections : pandas.DataFrame, optional
+        ``section``, ``L_start [m]``, ``L_end [m]`` (:func:`circuit_sections`); default one
+        section ``"all"``.
+    car : str
+        Car body of the rider.
+    rider_point : (3,) array_like, optional
+        Default the train's ``rider_point``.
+    peaks : pandas.DataFrame, optional
+        :func:`rider_peaks` of the same run, sections, car and rider point (computed if not
+        given): the ``peak [g]`` column is the section's extreme when it is beyond the level.
+    xtol : float, optional
+        Time tolerance of the located crossings and extremes (s).
+    jerk_step : float
+        eps (s) of the derivative along the flow.
+    warn : bool
+        Issue a :class:`core.signals.GridResolutionWarning` when an exceedance lies between two
+        outputs (the value here is right; a table on the output grid does not show it).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (section, limit row): ``section``, ``axis``, ``level [g]``,
+        ``max duration [s]``, ``peak [g]``, ``exceedances [-]``, ``time above [s]``,
+        ``longest [s]``, ``longest starts at [s]``, ``between outputs [-]`` (exceedances with no
+        output inside them), ``verdict``, ``basis``; ``attrs["method"]``, ``attrs["xtol_s"]``.
+    """
+    import warnings
+
+    from core.signals import GridResolutionWarning, dense_level_intervals
+
+    from .rider import read_acceleration_limits
+
+    limits = read_acceleration_limits() if limits is None else limits
+    rtol = float(run.meta.get("rtol", 1e-8))
+    h = float(run.meta.get("output_step", np.max(np.diff(run.t)) if len(run.t) > 1 else 1.0))
+    xtol = 10.0 * rtol * max(1.0, h) if xtol is None else float(xtol)
+    dense = _DenseLoads(run, car, rider_point, jerk_step)
+    if peaks is None:
+        peaks = rider_peaks(run, car, rider_point, sections)
+    pk = peaks.set_index("section")
+    period, labels, bounds = _section_labels(run, sections)
+    t, L1 = run.t, run.L[:, 0]
+    occ = _occurrences(t, L1, labels, bounds,
+                       lambda i, Lb: _boundary_time(t, L1, period, i, Lb, lambda u: dense(u)[2:]))
+    rows, missed = [], 0
+    for sec in dict.fromkeys(labels):
+        for _, lim in limits.iterrows():
+            ax = {"x": 0, "y": 1, "z": 2}[lim["axis"]]
+            level, allowed = float(lim["level [g]"]), float(lim["max duration [s]"])
+            side = "above" if level > 0 else "below"
+            ivs = []
+            for name, a, b, te, tx in occ:
+                if name != sec:
+                    continue
+                ts = [float(x) for x in t[a:b + 1]]
+                ts = sorted(set(([te] if te is not None else []) + [x for x in ts if (te is None or x > te)
+                                                                       and (tx is None or x < tx)]
+                                + ([tx] if tx is not None else [])))
+                if len(ts) < 2:
+                    continue
+                vals = [dense(x) for x in ts]
+                iv = dense_level_intervals(ts, [v[0][ax] for v in vals], [v[1][ax] for v in vals], level, side,
+                                           lambda u: (dense(u)[0][ax], dense(u)[1][ax]), xtol)
+                if len(iv):
+                    iv["between samples"] = ~_grid_sees(iv, t)
+                    ivs.append(iv)
+            iv = pd.concat(ivs, ignore_index=True) if ivs else None
+            if iv is None or not len(iv):
+                count, total, longest, at, nb, peak = 0, 0.0, 0.0, np.nan, 0, np.nan
+            else:
+                k = int(np.argmax(iv["duration [s]"].to_numpy()))
+                count, total = len(iv), float(iv["duration [s]"].sum())
+                longest, at = float(iv["duration [s]"].iloc[k]), float(iv["start [s]"].iloc[k])
+                nb = int(iv["between samples"].sum())
+                col = f"n_{lim['axis']} {'max' if level > 0 else 'min'} [g]"
+                peak = float(pk.loc[sec, col]) if sec in pk.index and col in pk.columns else \
+                    float(iv["peak"].max() if level > 0 else iv["peak"].min())
+            missed += nb
+            if np.isnan(allowed):
+                verdict = "no duration given"
+            elif count and (longest > allowed or allowed == 0.0):
+                verdict = "exceeds"
+            else:
+                verdict = "within"
+            rows.append({"section": sec, "axis": lim["axis"], "level [g]": level, "max duration [s]": allowed,
+                         "peak [g]": peak, "exceedances [-]": count, "time above [s]": total, "longest [s]": longest,
+                         "longest starts at [s]": at, "between outputs [-]": nb, "verdict": verdict,
+                         "basis": lim.get("basis", "")})
+    out = pd.DataFrame(rows)
+    out.attrs["source"] = limits.attrs.get("source", "")
+    out.attrs["xtol_s"] = xtol
+    out.attrs["method"] = ("crossings of each level located on re-integrated states (TrainRun.states_at) by "
+                           f"safeguarded Newton to {xtol:.2g} s, extremes between outputs searched where the slopes' "
+                           "tangents reach "
+                           "the level (core.signals.dense_level_intervals; coaster.train.time_above_limits_dense)")
+    if warn and missed:
+        warnings.warn(f"time_above_limits_dense: {missed} exceedances lie between two outputs (output step {h:.3g} s): "
+                      "their durations come from the dense solution, a table on the output grid does not show them",
+                      GridResolutionWarning, stacklevel=2)
+    return out
+
+
+def _grid_sees(iv, t_grid):
+    from core.signals import grid_resolution
+
+    return grid_resolution(iv, t_grid)
 
 
 def wheel_forces(run: TrainRun) -> pd.DataFrame:

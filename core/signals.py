@@ -39,7 +39,8 @@ import pandas as pd
 
 from .errors import InputError
 
-__all__ = ["GridResolutionWarning", "level_intervals", "peak", "grid_resolution", "level_summary"]
+__all__ = ["GridResolutionWarning", "level_intervals", "peak", "grid_resolution", "level_summary",
+           "hidden_extremes", "dense_level_intervals"]
 
 
 class GridResolutionWarning(UserWarning):
@@ -185,3 +186,158 @@ def level_summary(t, x, level=0.0, side="below", refine=None, t_grid=None, name=
                           f"{dt:.3g} s; shortest {out['shortest [s]']:.3g} s): the summary comes from the accepted "
                           "steps, a table on the output grid does not show them", GridResolutionWarning, stacklevel=2)
     return out
+
+
+def _oriented(x, dxdt, level, side):
+    """y = x − c (``side="above"``) or c − x (``"below"``): the set is y ≥ 0; and ẏ."""
+    if side not in ("below", "above"):
+        raise InputError(f"side must be 'below' or 'above', got {side!r}")
+    s = 1.0 if side == "above" else -1.0
+    return s * (np.asarray(x, float) - level), s * np.asarray(dxdt, float)
+
+
+def hidden_extremes(t, x, dxdt, level=0.0, side="above"):
+    r"""Sample intervals that may hide a pair of crossings of ``level`` (Eq. S2).
+
+    Between two samples on the same side of the level, the signal can still cross it twice: a
+    local extreme between them passes the level (a short exceedance, or a short dip back).  With
+    the slopes ẏ_i, ẏ_{i+1} at both samples (y = x − c, or c − x for ``side="below"``) an
+    interior extreme exists where the slope changes sign, and the two tangents bound it::
+
+        t* = (y_{i+1} − y_i + ẏ_i t_i − ẏ_{i+1} t_{i+1}) / (ẏ_i − ẏ_{i+1}),
+        y* = y_i + ẏ_i (t* − t_i)                                                         (S2)
+
+    y* bounds the maximum from above where y is concave on the interval (a maximum between
+    two samples outside the set, ẏ_i > 0 > ẏ_{i+1}) and the minimum from below where it is
+    convex (a minimum between two samples inside, ẏ_i < 0 < ẏ_{i+1}).  An interval is returned
+    when y* reaches the other side of the level.  Two extremes within one sample interval (a
+    slope that changes sign twice) are beyond what samples and slopes can resolve.
+
+    Parameters
+    ----------
+    t, x, dxdt : (n,) array_like
+        Times [s], signal and its time derivative at the samples.
+    level : float
+    side : {"above", "below"}
+
+    Returns
+    -------
+    (m,) int ndarray
+        Indices i of the intervals [t_i, t_{i+1}].
+    """
+    t, x = _samples(t, x, "hidden_extremes")
+    y, yd = _oriented(x, dxdt, level, side)
+    if t.size < 2:
+        return np.zeros(0, int)
+    y0, y1, d0, d1, t0, t1 = y[:-1], y[1:], yd[:-1], yd[1:], t[:-1], t[1:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ts = (y1 - y0 + d0 * t0 - d1 * t1) / (d0 - d1)
+        ys = y0 + d0 * (np.clip(ts, t0, t1) - t0)
+    peak_out = (y0 < 0) & (y1 < 0) & (d0 > 0) & (d1 < 0) & (ys >= 0)
+    dip_in = (y0 >= 0) & (y1 >= 0) & (d0 < 0) & (d1 > 0) & (ys < 0)
+    return np.flatnonzero(peak_out | dip_in)
+
+
+def dense_level_intervals(t, x, dxdt, level, side, evaluate: Callable[[float], tuple[float, float]],
+                          xtol: float, max_iter: int = 60):
+    r"""Intervals where ``x ≥ level`` (``side="above"``) or ``x ≤ level`` from a dense signal.
+
+    The samples (an output grid with the signal's slopes) only *bracket*; every boundary is
+    located on the dense signal ``evaluate(t) -> (x(t), dx/dt(t))`` (a run's dense output, or a
+    re-integration from the sample before):
+
+    1. every interval of :func:`hidden_extremes` (Eq. S2) is searched for its extreme, the root
+       of dx/dt bracketed by the slopes' sign change (Brent's method to ``xtol``); if the
+       extreme lies on the other side of the level, it is added as a sample, so that an
+       exceedance (or a dip) that lies entirely between two samples is bracketed;
+    2. each sign change of y = ±(x − level) between neighbouring samples is located by a
+       safeguarded Newton iteration ``t ← t − y/ẏ`` (bisection whenever the step leaves the
+       bracket or does not halve it) until the step or the bracket is below ``xtol``;
+    3. :func:`level_intervals` assembles the intervals from the samples and the located
+       boundaries.
+
+    Parameters
+    ----------
+    t, x, dxdt : (n,) array_like
+        Sample times [s] (strictly increasing), signal and its time derivative there.
+    level : float
+    side : {"above", "below"}
+    evaluate : callable
+        ``evaluate(t) -> (x, dx/dt)`` at any t in [t_0, t_{n−1}].
+    xtol : float
+        Time tolerance [s] of the located boundaries and extremes (derive it from the run's
+        rtol: a boundary is known no better than the integration error over the slope).
+    max_iter : int
+
+    Returns
+    -------
+    DataFrame
+        :func:`level_intervals`' columns (``resolution [s]`` is ``xtol`` for located
+        boundaries) plus ``peak`` (the largest value of y = ±(x − level) seen in the interval,
+        back in the unit of x: ``level ± max y``, from samples, located extremes and boundary
+        iterates) and ``between samples`` (no sample of the input grid lies in the interval).
+    """
+    import scipy.optimize as so
+
+    t, x = _samples(t, x, "dense_level_intervals")
+    s = 1.0 if side == "above" else -1.0
+    y, yd = _oriented(x, dxdt, level, side)
+    known = {float(a): (float(b), float(c)) for a, b, c in zip(t, y, yd)}
+
+    def ev(tt):
+        tt = float(tt)
+        if tt not in known:
+            xv, dv = evaluate(tt)
+            known[tt] = (s * (float(xv) - level), s * float(dv))
+        return known[tt]
+
+    extra = []
+    for i in hidden_extremes(t, x, dxdt, level, side):
+        a, b = float(t[i]), float(t[i + 1])
+        try:
+            tm = so.brentq(lambda u: ev(u)[1], a, b, xtol=xtol, maxiter=max_iter)
+        except ValueError:  # the slope's sign change did not survive re-evaluation
+            continue
+        if (ev(tm)[0] >= 0) != (y[i] >= 0):
+            extra.append(float(tm))
+    tt = np.array(sorted(set(map(float, t)) | set(extra)))
+    yy = np.array([known[float(u)][0] for u in tt])
+
+    def refine(a, b):
+        ya, yb = ev(a)[0], ev(b)[0]
+        lo, hi = (a, b) if ya < 0 else (b, a)  # y(lo) < 0 <= y(hi)
+        w = float(np.clip(ya / (ya - yb), 0.0, 1.0)) if ya != yb else 0.5
+        tc = a + w * (b - a)
+        for _ in range(max_iter):
+            yc, dc = ev(tc)
+            if yc < 0:
+                lo = tc
+            else:
+                hi = tc
+            width = abs(hi - lo)
+            step = -yc / dc if dc != 0 else np.inf
+            tn = tc + step
+            if not (min(lo, hi) < tn < max(lo, hi)) or abs(step) > 0.5 * width:
+                tn = 0.5 * (lo + hi)
+                step = tn - tc
+            tc = tn
+            if abs(step) <= xtol or width <= xtol:
+                break
+        return float(tc)
+
+    iv = level_intervals(tt, yy, 0.0, "above", refine=refine)
+    if len(iv):
+        iv["resolution [s]"] = float(xtol)
+        ks = np.array(sorted(known))
+        ys = np.array([known[u][0] for u in ks])
+        peaks, between = [], []
+        for a, b in zip(iv["start [s]"], iv["end [s]"]):
+            sel = (ks >= a) & (ks <= b)
+            peaks.append(level + s * float(ys[sel].max()) if sel.any() else float(level))
+            between.append(not bool(np.any((t >= a) & (t <= b))))
+        iv["peak"] = peaks
+        iv["between samples"] = between
+    else:
+        iv["peak"] = pd.Series(dtype=float)
+        iv["between samples"] = pd.Series(dtype=bool)
+    return iv

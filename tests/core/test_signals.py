@@ -6,6 +6,7 @@ its boundaries known exactly), and the outputs of a run with and without the rec
 the last bit: recording does not change the step sequence).
 """
 
+import math
 import warnings
 
 import numpy as np
@@ -15,7 +16,8 @@ import pytest
 from core import simulate
 from core.errors import InputError
 from core.models import simple_pendulum
-from core.signals import GridResolutionWarning, grid_resolution, level_intervals, level_summary, peak
+from core.signals import (GridResolutionWarning, dense_level_intervals, grid_resolution, hidden_extremes,
+                          level_intervals, level_summary, peak)
 
 
 def _lift_signal(t, a=0.1234, b=0.1264):
@@ -99,3 +101,24 @@ def test_recording_the_steps_changes_no_output(method):
         assert np.all(np.isin(b.t, st.t))
     # without the record the output grid fixes what a summary sees; with it the steps do
     assert isinstance(level_intervals(st.t, st.q[:, 0], 0.0, "above"), pd.DataFrame)
+
+
+def test_dense_intervals_find_an_exceedance_between_samples_and_locate_crossings():
+    """x = sin t sampled every 0.5 s, with its slope cos t and a dense evaluator: the level 0.9999
+    is exceeded for 2 acos(0.9999) = 28 ms around π/2, between the samples 1.5 and 2.0 s; the level
+    0.5 over [π/6, 5π/6] and [13π/6, 17π/6].  Crossings to xtol = 1e-12 s."""
+    t = np.arange(0.0, 9.51, 0.5)
+    for level, want in ((0.9999, [(math.pi / 2 - math.acos(0.9999), math.pi / 2 + math.acos(0.9999)),
+                                  (5 * math.pi / 2 - math.acos(0.9999), 5 * math.pi / 2 + math.acos(0.9999))]),
+                        (0.5, [(math.pi / 6, 5 * math.pi / 6), (13 * math.pi / 6, 17 * math.pi / 6)])):
+        assert (level == 0.5) or not np.any(np.sin(t) >= level)   # the samples never reach 0.9999
+        iv = dense_level_intervals(t, np.sin(t), np.cos(t), level, "above",
+                                   lambda u: (math.sin(u), math.cos(u)), xtol=1e-12)
+        got = list(zip(iv["start [s]"], iv["end [s]"]))
+        assert len(got) == len(want), got
+        for (a, b), (wa, wb) in zip(got, want):
+            assert abs(a - wa) < 1e-9 and abs(b - wb) < 1e-9
+        assert list(iv["between samples"]) == [level > 0.9] * 2
+    # below: a dip of -cos t under -0.9999 around t = 2π, and the grid-only screen
+    assert list(hidden_extremes(t, -np.cos(t), np.sin(t), -0.9999, "below")) == [12]
+    assert list(hidden_extremes(t, np.sin(t), np.cos(t), 1.5, "above")) == []

@@ -1036,6 +1036,50 @@ def _check_derailment(st, res, out, last_YQ):
             f"wheel {labels[i]!r}: {last(i)}")
 
 
+def _hermite_state(model, q_a, v_a, q_b, v_b, h, s_, axle_bodies=()):
+    r"""The state at the fraction ``s_`` of an interval of ``h`` seconds between two stored states,
+    for moving the search seeds between rows far apart (:func:`contact_history`).
+
+    Coordinates: the cubic Hermite through q̇ = Z(q) v at both ends (Euler parameters then
+    normalised); velocities: linear.  The axles of the wheelsets ``axle_bodies`` (body indices) are
+    then turned, each by the smallest rotation, onto the cubic Hermite of the axle direction a
+    itself through ȧ = ω × a at both ends (ω in global axes; a normalised).  The contact geometry
+    of a body of revolution depends on its centre and its axle, not on the spin angle, and the
+    axle turns slowly (yaw with the curve, roll) while the wheelset spins 2.2 rad between rows
+    50 ms apart at 20 m/s: the Hermite of the Euler parameters follows that spin only to (ω h)⁴
+    and tilts the axle by up to 7e-5 rad there (measured against the accepted steps), the axle's
+    own Hermite to 1e-10 rad.  A tilt of 2e-5 rad was enough for the scan to find a flange-root
+    patch that the run never had (issue 21).
+    """
+    from core import frames
+
+    q_a, v_a, q_b, v_b = (np.asarray(x, float) for x in (q_a, v_a, q_b, v_b))
+    h00, h10, h01, h11 = 2 * s_**3 - 3 * s_**2 + 1, s_**3 - 2 * s_**2 + s_, -2 * s_**3 + 3 * s_**2, s_**3 - s_**2
+    q = model.normalize(h00 * q_a + h10 * h * model.qdot(q_a, v_a) + h01 * q_b + h11 * h * model.qdot(q_b, v_b))
+    v = (1.0 - s_) * v_a + s_ * v_b
+    k = np.asarray(axle_bodies, dtype=np.int64)
+    if model.space.dim == 2 or k.size == 0:
+        return q, v
+
+    def axle(qq, vv):  # axle direction a = A e_y and its rate omega x a (global axes)
+        A = frames.euler_to_matrix(qq.reshape(-1, 7)[k, 3:])
+        w = np.einsum("nij,nj->ni", A, vv.reshape(-1, 6)[k, 3:])
+        return A[:, :, 1], np.cross(w, A[:, :, 1])
+
+    nb = model.n_bodies
+    (a_a, da_a), (a_b, da_b) = axle(q_a[: nb * 7], v_a[: nb * 6]), axle(q_b[: nb * 7], v_b[: nb * 6])
+    a = h00 * a_a + h10 * h * da_a + h01 * a_b + h11 * h * da_b
+    a /= np.linalg.norm(a, axis=1, keepdims=True)
+    qb_ = q[: nb * 7].reshape(nb, 7)
+    a_h = frames.euler_to_matrix(qb_[k, 3:])[:, :, 1]
+    c = np.cross(a_h, a)
+    sn = np.linalg.norm(c, axis=1)
+    ang = np.arctan2(sn, np.einsum("ni,ni->n", a_h, a))
+    rv = np.where((sn > 0.0)[:, None], c * (ang / np.where(sn > 0.0, sn, 1.0))[:, None], 0.0)
+    qb_[k, 3:] = frames.quat_multiply(frames.rotation_vector_to_euler(rv), qb_[k, 3:])
+    return q, v
+
+
 #: peaks refined by :func:`contact_history` at the accepted steps: (column, kind), kind "max",
 #: "min" or "absmax" (largest magnitude)
 PEAK_COLUMNS = (("Q [N]", "max"), ("Q [N]", "min"), ("Y [N]", "absmax"), ("Y/Q [-]", "max"),
@@ -1043,18 +1087,37 @@ PEAK_COLUMNS = (("Q [N]", "max"), ("Q [N]", "min"), ("Y [N]", "absmax"), ("Y/Q [
 
 
 def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at="outputs", locate_lift=None,
-                    lift_tol=1e-7, peak_samples=8):
+                    lift_tol=1e-7, peak_samples=8, seed_path="auto"):
     """Per output time (or accepted step) and wheel, what a railway engineer reads (long format).
 
     The outputs of :meth:`WheelRailKind.contact_outputs` are evaluated at the stored states of
-    ``result``, with the search state tracked along the run as the integrator tracks it: reset at
-    the first row, then carried from row to row through the accept hook at intermediate states
-    at most ``max_step`` apart (positions and velocities interpolated linearly between the stored
-    rows, Euler parameters normalised; these states only move the seeds, every row is evaluated
-    at its stored state).  A run re-seeds after every accepted step (~1 ms); replaying the
-    tracked state only at the output times (50 ms, a metre of track at 20 m/s, apart) would lose
-    patches that the run had, and a fresh global search at every row would pick the patches
-    afresh where two of them share a zone -- either would misstate the forces the run applied.
+    ``result``, with the search state tracked along the run as the integrator tracks it
+    (``seed_path``):
+
+    * ``"steps"`` (the default, ``"auto"``, when ``result.steps`` holds the accepted steps of a run
+      made with ``simulate(..., record_steps=True)``): reset at the first step, then carried
+      through the accept hook at every accepted step up to each output time, on the run's own
+      re-seeding schedule -- the search state the run had.  Each row is evaluated at its stored
+      state with the state of the last accepted step at or before it, which is the state the run
+      used for its forces there: the rows equal those of ``at="steps"`` where the times agree, and
+      do not depend on the output step.
+    * ``"hermite"`` (the default without recorded steps): reset at the first row, then carried from
+      row to row through the accept hook at intermediate states at most ``max_step`` apart -- the
+      positions interpolated by the cubic Hermite through q̇ = Z(q) v at both rows, the wheelsets'
+      axle directions by their own Hermite (:func:`_hermite_state`), the velocities linearly --
+      and at the row's stored state, at which the row is evaluated.  The intermediate states only
+      move the seeds.  Positions interpolated linearly (chords) cut the arc of a curve: between
+      rows 50 ms apart at 20 m/s in a 200 m curve a wheelset sat up to 0.53 mm inside the track
+      with its axle 1.5 mrad off, and the scan found there a flange-root patch that the run never
+      had (13.9 kN on a wheel load; issue 21, tests/railway/test_replay_seeds.py).  The Hermite
+      follows that motion to 1e-9 m and 1e-10 rad; it cannot follow motion faster than the rows
+      (e.g. a wheelset's bouncing on its Hertz springs), so the steps are preferred where
+      recorded.
+
+    A run re-seeds after every accepted step (~1 ms); replaying the tracked state only at the
+    output times (50 ms, a metre of track at 20 m/s, apart) would lose patches that the run had,
+    and a fresh global search at every row would pick the patches afresh where two of them share a
+    zone -- either would misstate the forces the run applied.
 
     ``at="steps"`` evaluates at every accepted step of a run made with
     ``simulate(..., record_steps=True)`` (``result.steps``) instead of the output times: the
@@ -1087,19 +1150,29 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
     Raises
     ------
     core.errors.InputError
-        ``at="steps"`` for a result without recorded steps, or an unknown ``at``.
+        ``at="steps"`` or ``seed_path="steps"`` for a result without recorded steps, or an unknown
+        ``at`` or ``seed_path``.
     """
     import pandas as pd
 
     from core.errors import InputError
 
+    steps = getattr(result, "steps", None)
+    if seed_path not in ("auto", "steps", "hermite"):
+        raise InputError(f"contact_history: seed_path must be 'auto', 'steps' or 'hermite', got {seed_path!r}")
     if at == "outputs":
         T, Qs, Vs = result.t, result.q, result.v
+        if seed_path == "auto":
+            seed_path = "hermite" if steps is None else "steps"
+        if seed_path == "steps" and steps is None:
+            raise InputError("contact_history(seed_path='steps'): the result holds no accepted steps; run "
+                             "simulate(..., record_steps=True)")
     elif at == "steps":
-        if getattr(result, "steps", None) is None:
+        if steps is None:
             raise InputError("contact_history(at='steps'): the result holds no accepted steps; run simulate(..., "
                              "record_steps=True)")
-        T, Qs, Vs = result.steps
+        T, Qs, Vs = steps
+        seed_path = "steps"
     else:
         raise InputError(f"contact_history: at must be 'outputs' or 'steps', got {at!r}")
     if locate_lift is None:
@@ -1120,6 +1193,36 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
         q = model.normalize(h00 * q_a + h10 * h * model.qdot(q_a, v_a) + h01 * q_b + h11 * h * model.qdot(q_b, v_b))
         v = (1.0 - s_) * v_a + s_ * v_b
         return kind.contact_outputs(model.body_states(q, v), float(tau), st.name)["wheels"]
+
+    if seed_path == "steps":
+        S_t, S_q, S_v = (np.asarray(x, float) for x in steps)
+    else:
+        axle_bodies = np.unique(np.concatenate([np.asarray(s_.bw, dtype=np.int64).ravel() for s_ in kind.sets]))
+    n_done = 0  # accepted steps replayed (seed_path "steps")
+
+    def carry(i, t, bs):  # the search state at row i (seed_path, docstring above)
+        nonlocal n_done
+        if seed_path == "steps":
+            if i == 0:  # the run's start: its first recorded state
+                kind.reset_state(model.body_states(S_q[0], S_v[0]), float(S_t[0]))
+                n_done = 1
+            # every accepted step at or before t, with the hook the integrator calls (its own
+            # re-seeding schedule), the derailment checks off
+            t_end = float(t) + 1e-12 * max(1.0, abs(float(t)))
+            while n_done < S_t.size and S_t[n_done] <= t_end:
+                kind.accept_step(model.body_states(S_q[n_done], S_v[n_done]), float(S_t[n_done]), check=False)
+                n_done += 1
+            return
+        if i == 0:
+            kind.reset_state(bs, float(t))
+            return
+        t_prev = float(T[i - 1])
+        n_sub = int(np.ceil((float(t) - t_prev) / max_step))
+        h = float(t) - t_prev
+        for k in range(1, n_sub):
+            qk, vk = _hermite_state(model, Qs[i - 1], Vs[i - 1], Qs[i], Vs[i], h, k / n_sub, axle_bodies)
+            kind.accept_step(model.body_states(qk, vk), t_prev + k / n_sub * h, reseed=True, check=False)
+        kind.accept_step(bs, float(t), reseed=True, check=False)
 
     def loaded_at(k, tau):
         return wheels_at(k, tau)["Q [N]"] > 0.0
@@ -1163,18 +1266,7 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
     try:
         for i, t in enumerate(T):
             bs = model.body_states(Qs[i], Vs[i])
-            if i == 0:
-                kind.reset_state(bs, float(t))
-            else:
-                t_prev = float(T[i - 1])
-                n_sub = int(np.ceil((float(t) - t_prev) / max_step))
-                for k in range(1, n_sub):
-                    w = k / n_sub
-                    qk = model.normalize((1.0 - w) * np.asarray(Qs[i - 1]) + w * np.asarray(Qs[i]))
-                    vk = (1.0 - w) * np.asarray(Vs[i - 1]) + w * np.asarray(Vs[i])
-                    kind.accept_step(model.body_states(qk, vk), t_prev + w * (float(t) - t_prev), reseed=True,
-                                     check=False)
-                kind.accept_step(bs, float(t), reseed=True, check=False)
+            carry(i, t, bs)
             out = kind.contact_outputs(bs, float(t), st.name)
             loaded = np.asarray(out["wheels"]["Q [N]"]) > 0.0
             if locate_lift and prev_loaded is not None and np.any(loaded != prev_loaded):
@@ -1218,6 +1310,7 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
     if wheels is not None:
         df = df[df["wheel"].isin(wheels)].reset_index(drop=True)
     df.attrs["at"] = at
+    df.attrs["seed path"] = seed_path
     if locate_lift:
         df.attrs["lift crossings"] = {lab: c for lab, c in crossings.items() if wheels is None or lab in wheels}
         df.attrs["lift tolerance [s]"] = float(lift_tol)

@@ -359,6 +359,8 @@ class RangeTable:
             v = float(v) if v.ndim == 0 else v
         else:
             v = parse_quantity(value, r.unit, where=label)
+        if isinstance(accept, str):  # accept="speed" means ["speed"], not its letters
+            accept = [accept]
         if quantity in set(accept):
             return v
         vals = np.atleast_1d(v)

@@ -85,6 +85,7 @@ def test_out_of_range_names_value_range_and_likely_slip(quantity, value, slip):
 
 def test_deliberate_outlier_is_accepted_by_name():
     assert RANGES.check("car_body_mass", 32, accept=["car_body_mass"]) == 32.0
+    assert RANGES.check("car_body_mass", 32, accept="car_body_mass") == 32.0
     with pytest.raises(ImplausibleValueError):
         RANGES.check("car_body_mass", 32, accept=["height"])
 

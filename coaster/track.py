@@ -44,6 +44,7 @@ import scipy.interpolate as si
 import scipy.special as sp
 
 from core.errors import DataFileError, InputError, NumericalFailure
+from core.inputs import checked_options
 
 __all__ = [
     "Centreline",
@@ -1136,6 +1137,7 @@ class BankCheck(NamedTuple):
     turns: object
 
 
+@checked_options
 def check_bank(frame, speed=None, *, step=1.0, gravity=G_BANK, turn_level=0.1, min_bank=math.radians(2.0),
                warn=True) -> BankCheck:
     r"""Compare the sign of a track's bank with the sign of its turns, weighted by v^2 kappa.
@@ -1239,6 +1241,7 @@ def check_bank(frame, speed=None, *, step=1.0, gravity=G_BANK, turn_level=0.1, m
     return res
 
 
+@checked_options
 def design_bank(centreline: Centreline, speed, *, step=2.0, gravity=G_BANK, min_vertical=1.0, smooth=10.0, name=None):
     r"""A bank (roll relative to the vertical) that cancels the quasi-static lateral load.
 

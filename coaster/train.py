@@ -109,6 +109,7 @@ from core.bodies import BodyStates
 from core.curves import FramedCurve
 from core.errors import InputError, ModelError
 from core.forces.protocol import ForceElement, ForceEval, ForceKind
+from core.inputs import checked_options
 from core.joints import CoordinateDriver, Spherical, Universal
 from core.model import Model, ModelBuilder
 
@@ -1054,6 +1055,7 @@ def _section_at(sections: pd.DataFrame | None, L: float, period: float) -> str:
     return str(hit["section"].iloc[0]) if len(hit) else "track"
 
 
+@checked_options
 def run_train(train: Train, L_start: float, speed: float, L_stop: float, *, chain: ChainLift | None = None,
               forces: TrackForces | None = None, method: str = "jit-dop853-projection", rtol: float = 1e-8,
               atol: float = 1e-8, output_step: float = 0.05, chunk: float = 10.0, t_max: float = 600.0,

@@ -70,6 +70,7 @@ import numpy as np
 import pandas as pd
 
 from core.errors import InputError, NumericalFailure
+from core.inputs import checked_options
 
 from .contact_search import FLANGE, ContactSearch, wheelset_pose
 from .profiles import WheelProfile
@@ -79,6 +80,7 @@ __all__ = ["rigid_contact", "contact_geometry_table", "equivalent_conicity", "co
            "flange_contact_onset", "contact_transitions"]
 
 
+@checked_options
 def rigid_contact(lateral, yaw=0.0, wheel=None, rail=None, gauge=1.435, inclination=1 / 40,
                   flange_back_spacing=1.360, tol=1e-10, max_iter=40, errors="raise", n_scan=64,
                   n_seeds=4, accept=()):
@@ -324,6 +326,7 @@ def _out_of_reach(wheel, mount, L, shift):
             "the back of its flange, at or beyond the end of the profile's contact zones)")
 
 
+@checked_options
 def contact_geometry_table(lateral=None, yaw=0.0, wheel=None, rail=None, gauge=1.435,
                            inclination=1 / 40, flange_back_spacing=1.360, flange_angle=np.pi / 4,
                            accept=()):

@@ -16,7 +16,7 @@ import pandas as pd
 
 from core.contact_laws import hertz_from_load
 from core.errors import InputError
-from core.inputs import closest
+from core.inputs import checked_options, closest
 
 from .creep import get_creep_model
 
@@ -41,6 +41,7 @@ def semi_axes_from_curvatures(normal_force, A, B, E, nu):
     return float(h.a[0]), float(h.b[0])
 
 
+@checked_options
 def creep_curve(models="polach2000", creepage: str = "xi", values=None, *, normal_force,
                 a=None, b=None, A=None, B=None, E=None, G=None, nu=0.28, mu=0.3,
                 xi=0.0, eta=0.0, phi=0.0, model_params=None, accept=()) -> pd.DataFrame:

@@ -41,6 +41,7 @@ import pandas as pd
 
 from core.contact_laws import hertz_from_penetration
 from core.errors import InputError
+from core.inputs import checked_options
 
 from .assessment import wheel_forces_track
 from .contact_geometry import rigid_contact
@@ -67,6 +68,7 @@ def _contact_forces(res, E, nu):
     return N, a, b
 
 
+@checked_options
 def quasi_static_contact(lateral, wheel_load, yaw=0.0, wheel=None, rail=None, gauge=1.435,
                          inclination=1 / 40, flange_back_spacing=1.360, E=2.1e11, nu=0.28,
                          tol=None, max_iter=50, accept=()):

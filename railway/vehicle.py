@@ -68,6 +68,7 @@ import pandas as pd
 
 from core import frames
 from core.errors import InputError
+from core.inputs import checked_options
 
 from .track import RailMounting
 
@@ -561,6 +562,7 @@ def _check_build_arguments(D, track, s0, speed, creep_law, creep_params, mu, lat
     return s0, speed, mu, lateral, wheelset_lateral, speed_control, control_gain
 
 
+@checked_options
 def build_vehicle(definition: VehicleDefinition, track, s0: float, speed: float = 0.0, *,
                   creep_law="kalker_linear", creep_params=None, mu=0.3, lateral=0.0,
                   wheelset_lateral=None, speed_control=None, control_gain=None, unloaded=True,

@@ -205,6 +205,7 @@ import numpy as np
 from core import frames
 from core.errors import DataRangeError, InputError, ModelError, NumericalFailure
 from core.forces.protocol import ForceElement, ForceEval, ForceJacobian, ForceKind
+from core.inputs import checked_options
 
 from .contact_search import ContactSearch
 from .forces import ContactForces
@@ -1086,6 +1087,7 @@ PEAK_COLUMNS = (("Q [N]", "max"), ("Q [N]", "min"), ("Y [N]", "absmax"), ("Y/Q [
                 ("flange force [N]", "max"))
 
 
+@checked_options
 def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at="outputs", locate_lift=None,
                     lift_tol=1e-7, peak_samples=8, seed_path="auto"):
     """Per output time (or accepted step) and wheel, what a railway engineer reads (long format).

@@ -533,3 +533,18 @@ def test_clearance_in_mm():
     with pytest.raises(ImplausibleValueError, match=r"check_clearance\(clearance=\.\.\.\): track clearance 1500 m is "
                                                     r"outside the plausible range 0\.2 m \.\.\. 20 m: did you mean 1500 mm\?"):
         check_clearance(Straight(10.0, name="s"), 1500.0)
+
+
+def test_misspelt_keywords_of_runs_and_bank_design_name_the_closest():
+    """A misspelt keyword of run_train / design_bank / check_bank is refused before any work,
+    with the closest accepted name (UnknownOptionError, also a TypeError)."""
+    from coaster.track import check_bank, design_bank
+    from coaster.train import run_train
+    from core.errors import UnknownOptionError
+
+    with pytest.raises(UnknownOptionError, match=r"run_train\(\): unknown option 'output_stp'; did you mean 'output_step'\?"):
+        run_train(None, 0.0, 1.0, 10.0, output_stp=0.1)
+    with pytest.raises(UnknownOptionError, match=r"design_bank\(\): unknown option 'smoth'; did you mean 'smooth'\?"):
+        design_bank(None, 10.0, smoth=5.0)
+    with pytest.raises(UnknownOptionError, match=r"check_bank\(\): unknown option 'stp'; did you mean 'step'\?"):
+        check_bank(None, 10.0, stp=1.0)

@@ -9,6 +9,7 @@ data and the scenes' inputs pass without a false alarm, and a value with a unit 
 result as the SI number.
 """
 
+import importlib
 import re
 import warnings
 from pathlib import Path
@@ -801,3 +802,26 @@ def test_speed_control_past_the_end_of_an_open_track_names_the_end(coach):
         kind._arc(SimpleNamespace(r=r), np.array([1.0]))
     r[kind.b[0]] = [20.0, 0.0, 1.8]
     assert kind._arc(SimpleNamespace(r=r), np.array([20.0]))[0] == pytest.approx(20.0)
+
+
+# ---------------------------------------------------------------------------------------------
+# misspelt keyword arguments of the public functions: the closest accepted one is named
+# ---------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("call, pattern", [
+    (lambda: importlib.import_module("railway.vehicle").build_vehicle(None, None, 30.0, sped=20.0),
+     r"build_vehicle\(\): unknown option 'sped'; did you mean 'speed'\?"),
+    (lambda: importlib.import_module("railway.contact_geometry").rigid_contact([0.0], gage=1.435),
+     r"rigid_contact\(\): unknown option 'gage'; did you mean 'gauge'\?"),
+    (lambda: importlib.import_module("railway.contact_geometry").contact_geometry_table([0.0], inclinaton=0.025),
+     r"contact_geometry_table\(\): unknown option 'inclinaton'; did you mean 'inclination'\?"),
+    (lambda: importlib.import_module("railway.quasi_static").quasi_static_contact([0.0], 5e4, yaww=0.0),
+     r"quasi_static_contact\(\): unknown option 'yaww'; did you mean 'yaw'\?"),
+    (lambda: importlib.import_module("railway.wheel_rail").contact_history(None, None, at_="steps"),
+     r"contact_history\(\): unknown option 'at_'; did you mean 'at'\?"),
+], ids=["build_vehicle sped", "rigid_contact gage", "contact_geometry_table inclinaton", "quasi_static yaww",
+        "contact_history at_"])
+def test_misspelt_keyword_names_the_closest(call, pattern):
+    from core.errors import UnknownOptionError
+
+    with pytest.raises(UnknownOptionError, match=pattern):
+        call()

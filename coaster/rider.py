@@ -400,6 +400,17 @@ def _section_runs(labels):
     return runs
 
 
+def limit_verdict(count: int, longest: float, allowed: float) -> str:
+    """The verdict of one limit row: ``"no duration given"`` (no allowed duration in the
+    limits file), ``"exceeds"`` (an exceedance longer than allowed, or any exceedance of a peak
+    limit with allowed duration 0) or ``"within"``."""
+    if np.isnan(allowed):
+        return "no duration given"
+    if count and (longest > allowed or allowed == 0.0):
+        return "exceeds"
+    return "within"
+
+
 def time_above_limits(loads, limits=None, sections=None, time_column="t [s]"):
     """Time spent beyond each level of an acceleration envelope, per axis and per track section,
     read from the output grid.
@@ -490,12 +501,7 @@ def time_above_limits(loads, limits=None, sections=None, time_column="t [s]"):
                 longest, at = float(ex["duration [s]"].iloc[k]), float(ex["start [s]"].iloc[k])
                 pk = ex["peak [g]"].to_numpy()
                 peak = float(pk[np.argmax(sgn * pk)])
-            if np.isnan(allowed):
-                verdict = "no duration given"
-            elif count and (longest > allowed or allowed == 0.0):
-                verdict = "exceeds"
-            else:
-                verdict = "within"
+            verdict = limit_verdict(count, longest, allowed)
             rows.append({"section": sec, "axis": lim["axis"], "level [g]": level, "max duration [s]": allowed,
                          "peak [g]": peak, "exceedances [-]": count, "time above [s]": total,
                          "longest [s]": longest, "longest starts at [s]": at, "verdict": verdict,

@@ -1568,7 +1568,7 @@ def time_above_limits_dense(run: TrainRun, limits: pd.DataFrame | None = None, s
 
     from core.signals import GridResolutionWarning, dense_level_intervals
 
-    from .rider import read_acceleration_limits
+    from .rider import limit_verdict, read_acceleration_limits
 
     limits = read_acceleration_limits() if limits is None else limits
     rtol = float(run.meta.get("rtol", 1e-8))
@@ -1616,12 +1616,7 @@ def time_above_limits_dense(run: TrainRun, limits: pd.DataFrame | None = None, s
                 peak = float(pk.loc[sec, col]) if sec in pk.index and col in pk.columns else \
                     float(iv["peak"].max() if level > 0 else iv["peak"].min())
             missed += nb
-            if np.isnan(allowed):
-                verdict = "no duration given"
-            elif count and (longest > allowed or allowed == 0.0):
-                verdict = "exceeds"
-            else:
-                verdict = "within"
+            verdict = limit_verdict(count, longest, allowed)
             rows.append({"section": sec, "axis": lim["axis"], "level [g]": level, "max duration [s]": allowed,
                          "peak [g]": peak, "exceedances [-]": count, "time above [s]": total, "longest [s]": longest,
                          "longest starts at [s]": at, "between outputs [-]": nb, "verdict": verdict,

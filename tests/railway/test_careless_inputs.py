@@ -825,3 +825,50 @@ def test_misspelt_keyword_names_the_closest(call, pattern):
 
     with pytest.raises(UnknownOptionError, match=pattern):
         call()
+
+
+# ---------------------------------------------------------------------------------------------
+# the README's "Checked inputs" snippets run here, so they cannot go stale
+# ---------------------------------------------------------------------------------------------
+def _readme_block(lang, after):
+    from core.paths import repo_root
+
+    text = (repo_root() / "README.md").read_text(encoding="utf-8")
+    i = text.index(f"```{lang}\n", text.index(after)) + len(lang) + 4
+    return text[i:text.index("```", i)]
+
+
+def test_readme_units_snippet_equals_the_manchester_file_in_si():
+    """The README's TOML snippet (values with units) laid over the Manchester file gives the same
+    vehicle as the SI file, to the digits the snippet writes."""
+    import tomllib
+
+    from core.paths import data_path
+    from railway.vehicle import VehicleDefinition
+
+    path = data_path("railway", "vehicles", "manchester_coach.toml")
+    base = tomllib.loads(path.read_text(encoding="utf-8"))
+    snippet = tomllib.loads(_readme_block("toml", "### Railway vehicles and track"))
+    for table, keys in snippet.items():
+        base[table].update(keys)
+    with_units = VehicleDefinition.from_dict(base, base_dir=path.parent)
+    si = VehicleDefinition.manchester()
+    assert with_units.car_body["mass"] == si.car_body["mass"] == 32000.0
+    np.testing.assert_allclose(with_units.car_body["inertia"], si.car_body["inertia"], rtol=1e-12)
+    np.testing.assert_allclose(with_units.primary["stiffness"], si.primary["stiffness"], rtol=3e-4)  # 31.4 of 31.391 MN/m
+    np.testing.assert_allclose(with_units.primary["damping"], si.primary["damping"], rtol=1e-12)
+    assert with_units.geometry["car_body_cg_height"] == pytest.approx(si.geometry["car_body_cg_height"], rel=1e-12)
+
+
+def test_readme_example_message_is_the_one_the_code_writes(tmp_path):
+    """The intro's example line of README "Checked inputs" is the message a 32 kg car body gets."""
+    from core.paths import data_path
+    from railway.vehicle import VehicleDefinition
+
+    text = data_path("railway", "vehicles", "manchester_coach.toml").read_text(encoding="utf-8")
+    f = tmp_path / "coach.toml"
+    f.write_text(text.replace("mass = 32000.0 ", "mass = 32 ", 1), encoding="utf-8")
+    line = _readme_block("", "## Checked inputs").strip()
+    with pytest.raises(ImplausibleValueError) as info:
+        VehicleDefinition.from_toml(f)
+    assert str(info.value) == f"{tmp_path}/{line}"

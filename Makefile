@@ -1,5 +1,6 @@
 # Two commands: `make run` writes every scene's tables and figures into out/;
-# `make test` runs the test-suite. Both create the virtual environment $(VENV) and
+# `make test` runs the test-suite (`make docs` builds the documentation into docs/_build/html).
+# All create the virtual environment $(VENV) and
 # install mbsuite into it in editable mode (again whenever pyproject.toml changes).
 
 PYTHON ?= $(shell command -v python3.11 2>/dev/null || command -v python3)
@@ -10,13 +11,17 @@ OUT    ?= out
 
 export MPLBACKEND := Agg
 
-.PHONY: run test bench clean
+.PHONY: run test bench docs clean
 
 run: $(STAMP)
 	$(BIN)/mbsuite run --all -o $(OUT)/
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
+
+# warnings are errors; the gallery runs examples/ in fast mode (docs/conf.py sets MBSUITE_MODE=fast)
+docs: $(STAMP)
+	$(BIN)/python -m sphinx -W --keep-going -b html docs docs/_build/html
 
 bench: $(STAMP)
 	@if [ -f benchmarks/run_all.py ]; then \
@@ -30,8 +35,8 @@ $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 
 $(STAMP): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[test]'
+	$(BIN)/python -m pip install --quiet -e '.[test,docs]'
 	touch $@
 
 clean:
-	rm -rf $(OUT) .pytest_cache .hypothesis build dist
+	rm -rf $(OUT) .pytest_cache .hypothesis build dist docs/_build docs/generated docs/auto_examples

@@ -57,11 +57,14 @@ def main(argv=None):
     from biomech.inverse_dynamics import inverse_dynamics, load_trial
     from biomech.muscle_forces import muscle_inputs, muscle_redundancy, reserve_optimal_forces
     from biomech.osim import read_force_set
-    from biomech.scenes import _trial_files, right_gait_cycle
+    from biomech.inverse_dynamics import right_gait_cycle
+    from core.paths import data_path
 
     peer = opensim_peer.available()
     rows = []
-    f = _trial_files()
+    d = data_path("biomech", "opensim", "gait10dof18musc_subject01_walk")
+    f = dict(model=d / "subject01.osim", motion=d / "subject01_walk_IK.mot", loads=d / "subject01_walk_grf.xml",
+             reserves=d / "gait10dof_Reserve_Actuators.xml")
     load = os.getloadavg()[0]
 
     # 1. inverse dynamics

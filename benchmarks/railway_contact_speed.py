@@ -10,15 +10,15 @@ sensitive to other load on the machine) and the elapsed wall time (``time.perf_c
    a clothoid, a curve with cant and lateral and vertical irregularities, called every 1 ms of
    travel with warm starts (target < 200 us per call on average):
 
-   * search only (four-condition contact search, :class:`railway.contact_search.ContactSearch`);
-   * search + forces: the same search followed by :class:`railway.forces.ContactForces` --
+   * search only (four-condition contact search, :class:`railway.contact.search.ContactSearch`);
+   * search + forces: the same search followed by :class:`railway.contact.forces.ContactForces` --
      Hertz normal force from the penetration with Lankarani-Nikravesh damping, creepages from
      the wheelset velocities, and the creep law (Kalker linear and Polach 2000), for all 8
      wheels (both tread and flange candidates);
 
    with global re-seeding every 10, 20 and 50 calls and without re-seeding, and a cold call.
    With numba installed the compiled kernels and the numpy implementations are measured side
-   by side (the numpy forces use the reference modules core.contact_laws, railway.creepage, railway.creep).
+   by side (the numpy forces use the reference modules core.contact_laws, railway.contact.creepage, railway.contact.creep).
 """
 
 from __future__ import annotations
@@ -28,10 +28,10 @@ import time
 import numpy as np
 import pandas as pd
 
-from railway._kernels import HAVE_NUMBA
-from railway.contact_geometry import conicity_table, contact_geometry_table, flange_contact_onset
-from railway.contact_search import ContactSearch, wheelset_pose
-from railway.forces import ContactForces
+from railway.contact.search.kernels import HAVE_NUMBA
+from railway.contact.geometry import conicity_table, contact_geometry_table, flange_contact_onset
+from railway.contact.search import ContactSearch, wheelset_pose
+from railway.contact.forces import ContactForces
 from railway.track import Curve, Irregularities, Straight, Track, Transition
 
 R0 = 0.46

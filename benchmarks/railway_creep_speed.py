@@ -16,7 +16,7 @@ import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from railway.creep import CREEP_MODELS, get_creep_model  # noqa: E402
+from railway.contact.creep import CREEP_MODELS, get_creep_model  # noqa: E402
 from core.contact_laws import hertz_from_load  # noqa: E402
 
 

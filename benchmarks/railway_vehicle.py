@@ -41,7 +41,7 @@ RESULTS = Path(__file__).resolve().parent / "results"
 
 
 def _errors(res, ref, veh):
-    from railway.wheel_rail import contact_history
+    from railway.vehicles.wheel_rail import contact_history
 
     ws = veh.wheelsets[0]
     y = res.coordinates()[f"{ws}.y [m]"].to_numpy()
@@ -51,7 +51,7 @@ def _errors(res, ref, veh):
 
 def work_precision(quick=False):
     from core.integrators import simulate
-    from railway.vehicle_scenes import run_curving
+    from railway.vehicles.curving import run_curving
 
     V, T = 20.0, 5.0
     ref, veh = run_curving("polach2000", V, T=T, rtol=1e-9, n_output_per_s=100)
@@ -109,7 +109,8 @@ def real_time(method="jit-dop853", rtol=1e-4, V=10.0, T=30.0):
     from core.compiled import dynamics as D
     from core.compiled.layout import compile_model
     from core.integrators import simulate
-    from railway.vehicle_scenes import curving_track, run_curving
+    from railway.vehicles.curving import curving_track
+    from railway.vehicles.curving import run_curving
 
     track = curving_track(curve_length=REAL_TIME_CURVE)
     run_curving("polach2000", V, T=0.05, track=track, method=method, rtol=rtol)  # compile and cache
@@ -185,9 +186,9 @@ QS_COLUMNS = ("Q [N]", "Y [N]", "Y/Q [-]", "flange force [N]", "lateral displace
 
 
 def _full_curve_means(H, curve_length):
-    """Means per wheel of the quasi-static columns in the full curve (vehicle_scenes.curve_window)
+    """Means per wheel of the quasi-static columns in the full curve (railway.vehicles.curving.curve_window)
     and the number of output times they average."""
-    from railway.vehicle_scenes import curve_window
+    from railway.vehicles.curving import curve_window
 
     W = curve_window(H, curve_length)
     return W.groupby("wheel", sort=False)[list(QS_COLUMNS)].mean(), int(W["t [s]"].nunique())
@@ -197,8 +198,9 @@ def accuracy_against_speed(V=10.0, T=30.0, rtols=(1e-3, 1e-4), reseeds=(1, 5), r
     """Real-time factor and error of jit-dop853 on the 30 s run at each tolerance (module
     docstring, item 3): one row per (rtol, scan every N accepted steps)."""
     from core.integrators import simulate
-    from railway.vehicle_scenes import curving_track, run_curving
-    from railway.wheel_rail import contact_history
+    from railway.vehicles.curving import curving_track
+    from railway.vehicles.curving import run_curving
+    from railway.vehicles.wheel_rail import contact_history
 
     track = curving_track(curve_length=REAL_TIME_CURVE)
     ref, veh = run_curving("polach2000", V, T=T, track=track, rtol=rtol_ref, n_output_per_s=10)
@@ -237,9 +239,9 @@ def accuracy_against_speed(V=10.0, T=30.0, rtols=(1e-3, 1e-4), reseeds=(1, 5), r
 
 def timed_cases():
     from core.integrators import simulate
-    from railway.two_point import conical_wheel
-    from railway.vehicle_scenes import linear_critical_speed
-    from railway.wheelset_models import free_wheelset
+    from railway.contact.two_point import conical_wheel
+    from railway.vehicles.critical_speed import linear_critical_speed
+    from railway.vehicles.wheelset_models import free_wheelset
 
     rows = []
     m = free_wheelset(5.0, 0.002, wheel=conical_wheel(), track_length=130.0)
@@ -265,7 +267,7 @@ def timed_cases():
 def write_test_states(path=None, rows=range(8, 51)):
     """States of the curving run (FASTSIM, 10 m/s, 5 outputs per s to t = 12.5 s) for
     tests/railway/test_wheel_rail.py::test_curving_forces_are_the_same_fresh_and_after_any_history."""
-    from railway.vehicle_scenes import run_curving
+    from railway.vehicles.curving import run_curving
 
     path = Path(path or Path(__file__).resolve().parents[1] / "tests" / "railway" / "curving_states_fastsim_10ms.npz")
     res, _ = run_curving("fastsim", 10.0, T=12.5, n_output_per_s=5)

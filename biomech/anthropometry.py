@@ -76,7 +76,7 @@ Knee
     The reference moves the tibia along splines of the knee angle.  The pin is put at the fixed
     centre that reproduces that motion best in the least-squares sense (:func:`fit_pin_centre`):
     with φ(q) the joint rotation and t(q) the translation of the child joint frame in the parent's,
-    find p_F (parent frame) and p_T (child frame) minimising Σ_j |p_F − t(q_j) − R(φ(q_j)) p_T|²
+    find p_F (parent frame) and p_T (child frame) minimising Σ_j ``|p_F − t(q_j) − R(φ(q_j)) p_T|²``
     over the coordinate's range, a linear least-squares problem.  The thigh and shank lengths are the
     hip–p_F and p_T–ankle distances.  For gait10dof18musc the fitted pin stays within 3.2 mm of the
     reference tibia over the whole range, against 15 mm at 60° flexion for a pin at the extended
@@ -606,7 +606,7 @@ def fit_pin_centre(joint: Joint, q_range, n: int = 261, where: str = ""):
 
     .. math::  \min_{p_F, p_T} \sum_j \left| p_F - R(\varphi(q_j))\, p_T - t(q_j) \right|^2 .
 
-    The residual |p_F − R p_T − t| at q is the distance between the child's position under the pin
+    The residual ``|p_F − R p_T − t|`` at q is the distance between the child's position under the pin
     and under the original joint (both rotated alike), so it bounds the kinematic difference.
 
     Parameters
@@ -945,8 +945,8 @@ def moment_differences(reference: pd.DataFrame, other: pd.DataFrame, coordinates
     -------
     DataFrame
         Indexed by coordinate: ``rms difference [N m]``, ``rms difference [% of peak]`` (of the
-        reference's peak |moment| in the window), ``max difference [N m]``,
-        ``peak reference [N m]``, ``peak other [N m]`` (max |moment|), ``n_frames``.
+        reference's peak ``|moment|`` in the window), ``max difference [N m]``,
+        ``peak reference [N m]``, ``peak other [N m]`` (max ``|moment|``), ``n_frames``.
     """
     ta, tb = reference["time [s]"].to_numpy(float), other["time [s]"].to_numpy(float)
     if len(ta) != len(tb) or not np.allclose(ta, tb, rtol=0.0, atol=1e-9):

@@ -386,7 +386,7 @@ class MultiplierFunction(Function1D):
 
 def linear_slope(function: Function1D) -> float | None:
     """Slope of a function that is exactly linear (``LinearFunction``, possibly wrapped in
-    ``MultiplierFunction``s: slope × scales), else None.  Used to tell a pure rotation or
+    ``MultiplierFunction`` objects: slope × scales), else None.  Used to tell a pure rotation or
     translation from a coupled one (see :mod:`biomech.osim`)."""
     scale = 1.0
     f = function
@@ -399,7 +399,7 @@ def linear_slope(function: Function1D) -> float | None:
 
 
 def is_constant(function: Function1D) -> bool:
-    """True for a ``Constant`` (possibly wrapped in ``MultiplierFunction``s)."""
+    """True for a ``Constant`` (possibly wrapped in ``MultiplierFunction`` objects)."""
     f = function
     while isinstance(f, MultiplierFunction):
         f = f.function

@@ -44,7 +44,7 @@ from core.errors import DataRangeError, InputError, ModelError
 from .checks import check_value, check_window, checked_options, ranges, warn_sampling
 from .kinematics import check_cutoff
 
-__all__ = ["GaitTrial", "load_trial", "inverse_dynamics", "gait_events"]
+__all__ = ["GaitTrial", "load_trial", "inverse_dynamics", "gait_events", "right_gait_cycle"]
 
 
 @dataclass
@@ -270,3 +270,29 @@ def gait_events(loads, body, threshold=20.0):
 
     bodies = [f.spec.applied_to_body for f in loads.forces]
     raise InputError(f"no external force acts on {body!r} (they act on {bodies}){name_hint(str(body), bodies)}")
+
+
+def right_gait_cycle(trial):
+    """The right gait cycle of a trial: two successive right heel strikes (start, end) [s].
+
+    Heel strikes from :func:`gait_events` on ``calcn_r``: its vertical ground reaction force
+    rises through 20 N.
+
+    Parameters
+    ----------
+    trial : GaitTrial
+
+    Returns
+    -------
+    (float, float)
+
+    Raises
+    ------
+    InputError
+        Fewer than two right heel strikes in the trial.
+    """
+    hs, _ = gait_events(trial.loads, "calcn_r")
+    if len(hs) < 2:
+        raise InputError(f"{trial.settings.get('external_loads', 'the trial')}: fewer than two right heel strikes "
+                         f"(calcn_r's vertical ground reaction rises through 20 N only {len(hs)} times)")
+    return float(hs[0]), float(hs[1])

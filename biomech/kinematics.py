@@ -14,7 +14,7 @@ filter order a parameter:
 
    .. math:: |H(f)| = \left[1 + \left(\frac{\tan(\pi f/f_s)}{\tan(\pi f_c/f_s)}\right)^{2N}\right]^{-1}
 
-   i.e. that of a 2N-th order filter, with |H(f_c)| = 1/2 (−6 dB) at the design cut-off f_c.
+   i.e. that of a 2N-th order filter, with ``|H(f_c)|`` = 1/2 (−6 dB) at the design cut-off f_c.
    **Defaults here: N = 2 per pass (4th order effective after the two passes), f_c = 6 Hz.**
    OpenSim's ``Storage::lowpassIIR`` calls ``Signal::LowpassIIR``, a *3rd-order* Butterworth IIR
    filter (bilinear, pre-warped), also run forward and backward -- 6th order effective, also

@@ -53,7 +53,8 @@ from core.errors import InputError
 
 from .checks import check_window, checked_options, name_hint
 
-__all__ = ["muscle_inputs", "muscle_redundancy", "reserve_optimal_forces", "PELVIS_RESIDUALS"]
+__all__ = ["muscle_inputs", "muscle_redundancy", "reserve_optimal_forces", "PELVIS_RESIDUALS", "group_force",
+           "cycle_peak", "frame_status", "reserve_summary", "status_summary"]
 
 #: OpenSim's pelvis residual actuators and the coordinate each one is taken on (the force
 #: components on the pelvis translations, the torques on the pelvis rotation about the same axis:
@@ -179,3 +180,135 @@ def muscle_redundancy(inputs, reserves, criterion="stress", exponent=None, passi
     t2 = time.perf_counter()
     df.attrs.update(passive=bool(passive), wall_time_build=t1 - t0, wall_time_solve=t2 - t1, wall_time_geometry=inputs["wall_time_geometry"])
     return df
+
+
+# ---------------------------------------------------------------------------------------------
+# summaries of the per-frame solutions
+# ---------------------------------------------------------------------------------------------
+def _residual_column(solution: pd.DataFrame) -> str:
+    return [c for c in solution.columns if c.startswith("max |R F")][0]
+
+
+def group_force(solution: pd.DataFrame, members) -> np.ndarray:
+    """The force of a muscle group per frame, F_group = Σ_j F_j over its ``members`` [N].
+
+    Parameters
+    ----------
+    solution : pandas.DataFrame
+        :func:`muscle_redundancy` (columns ``F_<muscle> [N]``).
+    members : sequence of str
+        Muscle names.
+
+    Returns
+    -------
+    (n_frames,) ndarray
+    """
+    return sum(solution[f"F_{m} [N]"] for m in members).to_numpy()
+
+
+def cycle_peak(y, pct, other_half: bool = False) -> dict:
+    """The largest value of ``y`` over the gait cycle and where it lies [% of the cycle].
+
+    With ``other_half`` also the largest value in the other half of the cycle (pct < 50 when the
+    peak lies at pct >= 50, else pct >= 50): the second peak of a group active twice per cycle.
+
+    Parameters
+    ----------
+    y : (n,) array_like
+        The quantity per frame (a group force, N).
+    pct : (n,) array_like
+        The frames' position in the gait cycle [%].
+    other_half : bool
+
+    Returns
+    -------
+    dict
+        ``peak force [N]``, ``at [% gait cycle]`` and, with ``other_half``, ``other-half peak [N]``,
+        ``at, other half [% gait cycle]``.
+    """
+    y, pct = np.asarray(y, float), np.asarray(pct, float)
+    i = int(np.argmax(y))
+    row = {"peak force [N]": float(y[i]), "at [% gait cycle]": float(pct[i])}
+    if other_half:
+        half = pct < 50.0 if pct[i] >= 50.0 else pct >= 50.0
+        j = int(np.argmax(np.where(half, y, -np.inf)))
+        row.update({"other-half peak [N]": float(y[j]), "at, other half [% gait cycle]": float(pct[j])})
+    return row
+
+
+def frame_status(solutions: dict, pct) -> pd.DataFrame:
+    """Per criterion and frame: the solver's status, the largest equation residual
+    max_i ``|Σ_j r_ij F_j + r_i^opt u_i − τ_i|`` and the solve time.
+
+    Parameters
+    ----------
+    solutions : dict
+        Criterion name -> :func:`muscle_redundancy` table.
+    pct : (n_frames,) array_like
+        The frames' position in the gait cycle [%].
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``criterion``, ``time [s]``, ``gait cycle [%]``, ``status``, ``max |R F + r - tau|``,
+        ``solve time [ms]``.
+    """
+    rows = []
+    for crit, d in solutions.items():
+        res = _residual_column(d)
+        for i in range(len(d)):
+            rows.append({"criterion": crit, "time [s]": float(d["time [s]"].iloc[i]),
+                         "gait cycle [%]": float(pct[i]), "status": d["status"].iloc[i],
+                         "max |R F + r - tau|": float(d.iloc[i][res]),
+                         "solve time [ms]": float(d["solve time [s]"].iloc[i] * 1e3)})
+    return pd.DataFrame(rows)
+
+
+def reserve_summary(solutions: dict) -> pd.DataFrame:
+    """Per criterion and reserve actuator: its largest magnitude and RMS over the frames.
+
+    Parameters
+    ----------
+    solutions : dict
+        Criterion name -> :func:`muscle_redundancy` table (columns ``reserve_<coordinate> [unit]``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``criterion``, ``reserve``, ``unit``, ``max |.|``, ``rms``.
+    """
+    rows = []
+    for crit, d in solutions.items():
+        for c in [c for c in d.columns if c.startswith("reserve_")]:
+            rows.append({"criterion": crit, "reserve": c, "unit": c[c.index("[") + 1:-1],
+                         "max |.|": float(d[c].abs().max()), "rms": float(np.sqrt(np.mean(d[c] ** 2)))})
+    return pd.DataFrame(rows)
+
+
+def status_summary(runs: dict) -> pd.DataFrame:
+    """Per run (criterion, passive force or not): frames per solver status, the largest equation
+    residual and the solve time per frame.
+
+    Parameters
+    ----------
+    runs : dict
+        (criterion, passive) -> :func:`muscle_redundancy` table.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``criterion``, ``passive force``, ``frames``, ``frames <status>`` (one column per status,
+        0 where a run has none), ``largest residual [unit]``, ``per frame [ms]``.
+    """
+    rows = []
+    for (crit, passive), d in runs.items():
+        counts = d["status"].value_counts().to_dict()
+        res = _residual_column(d)
+        rows.append({"criterion": crit, "passive force": "included" if passive else "left out (as OpenSim)",
+                     "frames": len(d), **{f"frames {k}": v for k, v in counts.items()},
+                     f"largest residual {res[res.index('['):]}": float(d[res].max()),
+                     "per frame [ms]": 1e3 * d.attrs["wall_time_solve"] / len(d)})
+    st = pd.DataFrame(rows)
+    fc = [c for c in st.columns if c.startswith("frames ")]
+    st[fc] = st[fc].fillna(0).astype(int)
+    return st

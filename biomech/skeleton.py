@@ -73,7 +73,7 @@ A path is the polyline through its *active* points (OpenSim ``GeometryPath`` wit
 ``PathPoint`` always, ``ConditionalPathPoint`` while ``range[0] − 1e-5 ≤ q_c ≤ range[1] + 1e-5``
 (``ConditionalPathPoint::isActive``), ``MovingPathPoint`` with its location components
 f_k(clamp(q_{c_k}, range of c_k)) in its body (``MovingPathPoint::getLocation``).  With the active
-points p_1 … p_m in ground and e_k = (p_{k+1} − p_k)/|p_{k+1} − p_k|,
+points p_1 … p_m in ground and e_k = (p_{k+1} − p_k)/``|p_{k+1} − p_k|``,
 
 .. math::
 
@@ -313,7 +313,7 @@ class MusclePath:
     positions : ndarray, shape (m, 3)
         Their positions in ground [m].
     length : float
-        Σ |p_{k+1} − p_k| [m].
+        Σ ``|p_{k+1} − p_k|`` [m].
     """
 
     muscle: str
@@ -348,7 +348,7 @@ class MomentArmCheck:
 
     @property
     def error(self) -> np.ndarray:
-        """|analytic − finite difference|, NaN where not :attr:`valid`."""
+        """``|analytic − finite difference|``, NaN where not :attr:`valid`."""
         return np.where(self.valid, np.abs(self.analytic - self.finite_difference), np.nan)
 
     @property

@@ -92,13 +92,13 @@ of a ``PiecewiseLinearFunction`` the one-sided derivative of the interval that h
     \dot J \dot q \approx \frac{J(q + h\dot q) - J(q - h\dot q)}{2h}\,\dot q,
     \qquad h = \delta / \max_i |\dot q_i|,                                      \quad (7)
 
-whose error is h²/6 · |d³(J q̇)/ds³| (truncation along the path s = h) plus about
-ε |J| |q̇| / h (rounding); with the coordinate step δ = 1e-5 (rad or m) both are of order
-1e-10 |J| |q̇|² — for gait (|q̇| ≲ 10 rad/s, |J| ≲ 1 m) below 1e-8 m/s².  It costs two more
+whose error is h²/6 · ``|d³(J q̇)/ds³|`` (truncation along the path s = h) plus about
+ε ``|J|`` ``|q̇|`` / h (rounding); with the coordinate step δ = 1e-5 (rad or m) both are of order
+1e-10 ``|J|`` ``|q̇|²`` — for gait (``|q̇|`` ≲ 10 rad/s, ``|J|`` ≲ 1 m) below 1e-8 m/s².  It costs two more
 evaluations of the Jacobians and is kept as the independent check of Eq. (6) (see the tests).
 
 Validation (``tests/biomech/test_spatial_dynamics.py``)
-------------------------------------------------------
+-------------------------------------------------------
 * A two-axis pendulum against Lagrange's equations in closed form: 1e-10 N m (analytic J̇q̇),
   1e-7 N m (Eq. 7).
 * gait10dof18musc against the Cartesian-core pipeline (driving constraints and multipliers,

@@ -65,7 +65,7 @@ frame only changes parameter values and reuses the compiled problem data:
   either.
 
 Accuracy.  Clarabel stops when the duality gap is below 1e-8 in absolute terms or relative to
-max(1, |J|), so for J < 1 the test is absolute.  For a criterion with curvature m along the
+max(1, ``|J|``), so for J < 1 the test is absolute.  For a criterion with curvature m along the
 feasible set the activations are then accurate to about sqrt(2e-8 / m): ~1e-7 for the QP of
 sum a^2, ~1e-5 to 1e-4 for sum s^3 (curvature 6 c^2 s), less (in relative terms) on frames of
 very low effort.  Tighter ``solver_options`` (``tol_gap_abs``, ``tol_gap_rel``, ``tol_feas``)
@@ -86,7 +86,7 @@ that fails does not stop the trial:
 * ``"solver_error"``: Clarabel failed; NaN solution;
 * ``"invalid_input"``: a non-finite or negative input in that frame (named in ``message``); NaN.
 
-The residual max |R F + G u - tau| is reported for every frame in the units of the coordinates.
+The residual max ``|R F + G u - tau|`` is reported for every frame in the units of the coordinates.
 
 References
 ----------
@@ -99,7 +99,7 @@ References
 .. [3] M. P. T. Silva, J. A. C. Ambrósio, "Solution of redundant muscle forces in human locomotion
    with multibody dynamics and optimization tools", Mech. Based Des. Struct. Mach. 31 (2003)
    381-411 (sigma = 31.39 N/cm^2).
-.. [4] opensim-core, ``OpenSim/Analyses/StaticOptimizationTarget.cpp`` (objective sum |x|^p over all
+.. [4] opensim-core, ``OpenSim/Analyses/StaticOptimizationTarget.cpp`` (objective sum ``|x|^p`` over all
    actuators, optimal force of a muscle from ``calcInextensibleTendonActiveFiberForce(s, 1.0)``).
 .. [5] A. Agrawal, B. Amos, S. Barratt, S. Boyd, S. Diamond, J. Z. Kolter, "Differentiable convex
    optimization layers", NeurIPS 2019 (disciplined parametrized programming, DPP);
@@ -301,7 +301,7 @@ class FrameSolution:
 
     @property
     def max_residual(self) -> float:
-        """max |R F + G u - tau| [N m or N] (NaN without solution)."""
+        """max ``|R F + G u - tau|`` [N m or N] (NaN without solution)."""
         return float(np.max(np.abs(self.residual))) if np.all(np.isfinite(self.residual)) else math.nan
 
 
@@ -343,7 +343,7 @@ class StaticOptimization:
         Bounds on the reserve controls, scalars or arrays of shape (n_coordinates,); ±inf for none.
         Default unbounded (OpenSim's CoordinateActuator default).
     reserve_weight : float
-        w > 0 multiplying the reserves' sum |u|^p (1 reproduces OpenSim).
+        w > 0 multiplying the reserves' sum ``|u|^p`` (1 reproduces OpenSim).
     activation_bounds : (lower, upper)
         Activation bounds, scalars or arrays of shape (n_muscles,), 0 <= lower < upper <= 1;
         default (0, 1).  (OpenSim's Thelen muscles use a minimum activation of 0.01.)
@@ -353,9 +353,9 @@ class StaticOptimization:
     solver_options : dict, optional
         Clarabel settings (e.g. ``tol_feas``), passed through cvxpy.
     epigraph : {"power_cone", "soc"}
-        How sum |x|^p is written when it is neither a plain sum nor a sum of squares of a variable:
+        How sum ``|x|^p`` is written when it is neither a plain sum nor a sum of squares of a variable:
         ``"soc"`` (default), cvxpy's ``power`` atom (second-order cones; exact for integer p such
-        as 3); ``"power_cone"``, the epigraph t >= |x|^p as Clarabel's native 3-D power cones.
+        as 3); ``"power_cone"``, the epigraph t >= ``|x|^p`` as Clarabel's native 3-D power cones.
     fast_path : bool
         Solve each frame's first attempt through cvxpy's parameter tensor applied directly
         (:class:`_ClarabelData`: one sparse product per frame instead of rebuilding the solver's

@@ -29,10 +29,10 @@ S-curve             bead, RMF; frames compared             κ linear through 0: 
 Load factors are those of :func:`coaster.rider.rider_loads` (car axes x forward, y left, z up).
 
 **Tolerances from the integrator's settings.**  Every run uses ``dop853-projection`` with
-rtol = atol = ``RTOL`` (1e-10).  A comparison passes when |simulated − closed form| ≤
+rtol = atol = ``RTOL`` (1e-10).  A comparison passes when ``|simulated − closed form|`` ≤
 K · rtol · scale with K = ``K_TOL`` = 1e3 (the global error of an rtol-controlled explicit
 method over the 10²–10³ steps of a run stays within 10–100 rtol; K leaves a further factor 10)
-and scale the size of the quantity: 1 + |L| (m) for arc lengths, 1 + v (m/s) for speeds,
+and scale the size of the quantity: 1 + ``|L|`` (m) for arc lengths, 1 + v (m/s) for speeds,
 m (g + v²/ρ) (N) for forces, 1 + q (g) for load factors, 1 + q/τ (g/s) for the jerk with τ the
 time to cross the track.  The rotation-minimising frame is a quintic Hermite table; with
 ``max_step`` = 0.25 m its interpolation error (h|ω|)⁶/46080 is below 1e-14 on these tracks,
@@ -74,8 +74,8 @@ from .path_joint import PathFollowingJoint
 from .rider import read_acceleration_limits, rider_loads, time_above_limits
 from .track import CircularArc, Clothoid, Helix, Segment, Straight
 
-__all__ = ["G", "K_TOL", "METHOD", "RTOL", "Parabola", "analytic_cases", "coaster_analytic_scene",
-           "run_coaster_analytic"]
+__all__ = ["G", "K_TOL", "METHOD", "RTOL", "SCENE", "Parabola", "analytic_cases", "coaster_analytic_scene",
+           "run_body_on_track"]
 
 G = 9.81
 METHOD = "dop853-projection"
@@ -168,8 +168,48 @@ class Parabola(Segment):
 # ---------------------------------------------------------------------------------------------
 # one run
 # ---------------------------------------------------------------------------------------------
-def _run(name, curve, L0, Ld0, t_end, mass=1.0, inertia=(0.0, 0.0, 0.0), t_eval=None, n_output=101,
-         rtol=RTOL):
+def run_body_on_track(name, curve, L0, Ld0, t_end, mass=1.0, inertia=(0.0, 0.0, 0.0), t_eval=None, n_output=101,
+                      rtol=RTOL):
+    r"""One body on a framed track through the path-following joint, integrated by :data:`METHOD`.
+
+    The body ``car`` (mass m, principal inertias J) is locked to the track frame at arc length L,
+    an extra coordinate: the six rows Φ1 = r + A s′ − g(L), n·u_ξ, b·u_ξ, n·u_ζ of
+    :class:`coaster.path_joint.PathFollowingJoint` (Pombo & Ambrósio 2003), with L̈ from the
+    equations of motion under gravity (0, 0, −g), g = :data:`G`; rtol = atol = ``rtol``.
+
+    Parameters
+    ----------
+    name : str
+        The run's name (model name; in the error message of a failed run).
+    curve : core.curves.FramedCurve
+        The track with its frame (:mod:`coaster.frames`).
+    L0, Ld0 : float
+        Initial arc length (m) and speed along the track (m/s).
+    t_end : float
+        End time (s).
+    mass : float
+        m (kg).
+    inertia : (3,) array_like
+        J_t, J_n, J_b (kg m²) about the body axes (0 for a bead).
+    t_eval : (n,) array_like, optional
+        Output times (s); default ``n_output`` equally spaced.
+    n_output : int
+    rtol : float
+        rtol = atol of the integrator.
+
+    Returns
+    -------
+    model : core.model.Model
+    joint : coaster.path_joint.PathFollowingJoint
+    res : core.results.SimulationResult
+    reactions : pandas.DataFrame
+        :meth:`~coaster.path_joint.PathFollowingJoint.reaction_table` (track frame, N and N m).
+
+    Raises
+    ------
+    RuntimeError
+        If the run failed (its message).
+    """
     joint = PathFollowingJoint("path", "car", curve, "L")
     r, p, v, w = joint.initial_state(L0, Ld0)
     b = ModelBuilder(3, name.replace(" ", "_").replace("-", "_"), gravity=(0.0, 0.0, -G))
@@ -209,7 +249,7 @@ def _helix(fast):
     acc = -m * G * sa / (m + (J[0] * sa**2 + J[2] * ca**2) / h**2)
     L0, Ld0, T = 5.0, 15.0, (1.0 if fast else 2.0)
     curve = FrenetFrame(Helix(R, c, 6 * math.pi), name="Frenet frame of a helix")
-    model, joint, res, reac = _run("helix", curve, L0, Ld0, T, m, J)
+    model, joint, res, reac = run_body_on_track("helix", curve, L0, Ld0, T, m, J)
     t = res.t
     L, Ld = res.q[:, model.n_bodies * 7], _Ldot(res, model)
     Lx, Vx = L0 + Ld0 * t + 0.5 * acc * t**2, Ld0 + acc * t
@@ -236,7 +276,7 @@ def _loop(fast):
     from .track import VerticalLoop
 
     curve = RotationMinimisingFrame(VerticalLoop(R), max_step=0.25, tol=1e-12, name="RMF of a vertical loop")
-    model, joint, res, reac = _run("vertical loop", curve, 0.0, vb, t_top, m, (0.0, 0.0, 0.0), t_eval=t_eval)
+    model, joint, res, reac = run_body_on_track("vertical loop", curve, 0.0, vb, t_top, m, (0.0, 0.0, 0.0), t_eval=t_eval)
     L, Ld = res.q[:, model.n_bodies * 7], _Ldot(res, model)
     phi = L / R
     v2 = vb**2 - 2 * G * R * (1 - np.cos(phi))
@@ -276,7 +316,7 @@ def _banked(fast, perfect):
                                     name=f"RMF of a circle banked {math.degrees(beta):.1f} deg")
     T = 1.0 if fast else 3.0
     name = "banked circle (perfect bank)" if perfect else "banked circle"
-    model, joint, res, reac = _run(name, curve, 0.0, v, T, m, J)
+    model, joint, res, reac = run_body_on_track(name, curve, 0.0, v, T, m, J)
     Ld = _Ldot(res, model)
     w = v / R
     RP = R - hs * math.sin(beta)
@@ -307,7 +347,7 @@ def _clothoid(fast, s_curve):
     curve = RotationMinimisingFrame(seg, max_step=0.25, tol=1e-12)
     T = length / v * (0.5 if fast else 1.0)
     name = "S-curve" if s_curve else "clothoid"
-    model, joint, res, reac = _run(name, curve, 0.0, v, T, 1.0, (0.0, 0.0, 0.0))
+    model, joint, res, reac = run_body_on_track(name, curve, 0.0, v, T, 1.0, (0.0, 0.0, 0.0))
     L, Ld = res.q[:, model.n_bodies * 7], _Ldot(res, model)
     loads = rider_loads(model, res, "car", coordinate="L")
     t = res.t
@@ -331,7 +371,7 @@ def _parabola(fast):
     curve = RotationMinimisingFrame(seg, max_step=0.25, tol=1e-12, name="RMF of a ballistic parabola")
     T_flight = 2 * v0 * math.sin(gam) / G
     T = T_flight * (0.5 if fast else 0.95)
-    model, joint, res, reac = _run("ballistic parabola", curve, 0.0, v0, T, m, (0.0, 0.0, 0.0))
+    model, joint, res, reac = run_body_on_track("ballistic parabola", curve, 0.0, v0, T, m, (0.0, 0.0, 0.0))
     t = res.t
     L, Ld = res.q[:, model.n_bodies * 7], _Ldot(res, model)
     Lx = seg.L_of_x(v0 * math.cos(gam) * t)
@@ -388,10 +428,32 @@ def _frames_where_frenet_breaks(n):
 
 
 def analytic_cases(fast=False):
-    """Run every case; returns (comparison table, run table, figure panels, frames table, extras).
+    """Run every case of the module docstring's table against its closed form.
 
-    The comparison table has one row per (case, quantity) with the simulated value and the closed
-    form at the sample of largest error, |error|, the tolerance K_TOL · rtol · scale and ``pass``.
+    A comparison passes when ``|simulated − closed form|`` ≤ :data:`K_TOL` · rtol · scale (module
+    docstring, "Tolerances from the integrator's settings").
+
+    Parameters
+    ----------
+    fast : bool
+        Shorter runs and fewer samples (the scene's fast mode).
+
+    Returns
+    -------
+    comparison : pandas.DataFrame
+        One row per (case, quantity): the simulated value and the closed form at the sample of
+        largest error, ``|error|``, ``tolerance``, ``error/tolerance``, ``samples``, ``pass``.
+    runs : pandas.DataFrame
+        One row per run: method, tolerances, status, steps, largest position violation, energy
+        drift, wall time.
+    panels : list of dict
+        Per figure panel ``x``, ``sim``, ``exact`` (arrays) and ``xlabel``, ``ylabel``, ``title``.
+    frames : pandas.DataFrame
+        Frenet against the rotation-minimising frame on a straight, the S-curve and a helix.
+    extras : dict
+        ``loop_loads`` (rider loads on the loop), ``loop_limits`` (their time above the
+        acceleration limits), ``bank_points`` ((β [deg], n_y, n_z, q) of the two banked runs),
+        ``frame_curves`` (:func:`coaster.frames.frame_quality` of each frame on the S-curve).
     """
     rows, runs, panels = [], [], []
 
@@ -434,87 +496,16 @@ def analytic_cases(fast=False):
 
 
 # ---------------------------------------------------------------------------------------------
-# figures and the scene
+# the scene: examples/coaster/analytic.py
 # ---------------------------------------------------------------------------------------------
-def _title():
-    from core.plot import run_title
-
-    return run_title({"method": METHOD, "rtol": RTOL, "atol": RTOL}, subject=f"{SCENE} scene")
-
-
-def _figure_closed_forms(panels, bank_points):
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(11, 10), layout="constrained")
-    ax = fig.subplots(3, 2, squeeze=False).ravel()
-    for a, p in zip(ax, panels):
-        a.plot(p["x"], p["exact"], "-", lw=2.5, color="0.75", label="closed form")
-        a.plot(p["x"], p["sim"], "--", lw=1.2, color="C0", label="simulated")
-        a.set(xlabel=p["xlabel"], ylabel=p["ylabel"])
-        a.set_title(p["title"], fontsize=8)
-        a.grid(True, alpha=0.3)
-        a.legend(fontsize=7)
-    a = ax[len(panels)]
-    q = bank_points[0][3]
-    b = np.linspace(0.0, 60.0, 121)
-    br = np.radians(b)
-    a.plot(b, q * np.cos(br) - np.sin(br), "-", color="C1", label="n_y closed form")
-    a.plot(b, q * np.sin(br) + np.cos(br), "-", color="C2", label="n_z closed form")
-    for beta, ny, nz, _ in bank_points:
-        a.plot([beta, beta], [ny, nz], "o", color="k", ms=5)
-    a.plot([], [], "o", color="k", label="simulated (30 deg; perfect bank)")
-    a.set(xlabel="bank angle β [deg]", ylabel="load factor at the track [g]")
-    a.set_title(f"banked circle R 30 m, 20 m/s (q = {q:.3f}): load factors against the bank", fontsize=8)
-    a.grid(True, alpha=0.3)
-    a.legend(fontsize=7)
-    fig.suptitle(_title() + "\nbodies on analytic tracks against their closed forms", fontsize=10)
-    return fig
-
-
-def _figure_frames(curves):
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(8, 4.5), layout="constrained")
-    a = fig.subplots()
-    for name, fq in curves.items():
-        a.semilogy(fq["L_m"], fq["rotation_step_rad"], lw=1.2, label=name)
-    fq = next(iter(curves.values()))
-    a.semilogy(fq["L_m"], fq["expected_step_rad"], ":", color="k", lw=1.0, label="|ω| ΔL (expected)")
-    a.set(xlabel="L [m]", ylabel="rotation between neighbouring samples [rad]")
-    a.grid(True, which="both", alpha=0.3)
-    a.legend(fontsize=8)
-    a.set_title(f"{SCENE} scene: frames on the S-curve (clothoid through κ = 0 at L = 30 m);\n"
-                "Frenet flips by π at the inflection, the rotation-minimising frame turns smoothly", fontsize=9)
-    return fig
-
-
-def run_coaster_analytic(ctx):
-    """Scene function: run the cases, return the tables, figures and notes."""
-    from core.scenes import SceneResult
-
-    comp, runs, panels, frames_table, extras = analytic_cases(fast=ctx.fast)
-    figs = {"closed_forms": _figure_closed_forms(panels, extras["bank_points"]),
-            "frames_s_curve": _figure_frames(extras["frame_curves"])}
-    n_fail = int((~comp["pass"]).sum())
-    lim = read_acceleration_limits()
-    notes = (f"Integrator {METHOD}, rtol = atol = {RTOL:g}; a comparison passes when |error| <= {K_TOL:g} x rtol x "
-             f"scale (see `comparison`): {len(comp) - n_fail} of {len(comp)} pass, largest error/tolerance "
-             f"{comp['error/tolerance'].max():.3g}.  Closed forms from notes/coaster.md; loads in car axes "
-             "(x forward, y left, z up) from `coaster.rider.rider_loads`, jerk as the derivative of the load factor "
-             "along the state's flow.\n\nThe loop's time above the acceleration limits uses "
-             f"`data/coaster/acceleration_limits.csv` ({lim.attrs['source'][:160]}...).")
-    tables = {"comparison": comp, "runs": runs, "frames_where_frenet_breaks": frames_table,
-              "loop_rider_loads": extras["loop_loads"], "loop_time_above_limits": extras["loop_limits"]}
-    return SceneResult(tables=tables, figures=figs, notes=notes)
-
-
 def coaster_analytic_scene():
-    """The ``coaster-analytic`` :class:`core.scenes.Scene` (register it in coaster/scenes.py)."""
-    from core.scenes import Scene
+    """The ``coaster-analytic`` scene: the example script ``examples/coaster/analytic.py``."""
+    from core.scenes import example_scene
 
-    return Scene(SCENE, "Coaster analytic: bodies on a helix, loop, banked circle, clothoid, parabola and S-curve "
-                        "against closed forms",
-                 "Path-following joint (Pombo & Ambrosio 2003) on analytic tracks, each run against its closed form "
-                 "(speed, reactions, rider load factors, zero multiplier on the ballistic parabola), tolerances "
-                 "from the integrator's rtol; Frenet vs rotation-minimising frame where Frenet breaks.",
-                 run_coaster_analytic)
+    return example_scene(SCENE, "coaster/analytic.py",
+                         "Coaster analytic: bodies on a helix, loop, banked circle, clothoid, parabola and S-curve "
+                         "against closed forms",
+                         "Path-following joint (Pombo & Ambrosio 2003) on analytic tracks, each run against its closed "
+                         "form (speed, reactions, rider load factors, zero multiplier on the ballistic parabola), "
+                         "tolerances from the integrator's rtol; Frenet vs rotation-minimising frame where Frenet "
+                         "breaks.")

@@ -6,15 +6,15 @@ Darboux vector omega and omega' at any arc length L, fast ``evaluate_raw``) and 
 tangent, n lateral/normal, b binormal/up.  The two providers are interchangeable for a path
 joint:
 
-================================  ============================  ==============================
-frame                             omega                          omega'
-================================  ============================  ==============================
-Frenet (:class:`FrenetFrame`)     tau t + kappa b                tau' t + kappa' b
-RMF + bank theta                  theta' t + t x g''             theta'' t + theta' g'' + t x g'''
+================================== ================== =================================
+frame                              omega              omega'
+================================== ================== =================================
+Frenet (:class:`FrenetFrame`)      tau t + kappa b    tau' t + kappa' b
+RMF + bank theta                   theta' t + t x g'' theta'' t + theta' g'' + t x g'''
 (:class:`RotationMinimisingFrame`)
-================================  ============================  ==============================
+================================== ================== =================================
 
-with kappa = |g''|, n = g''/kappa, kappa' = g''.g'''/kappa, tau = t.(g'' x g''')/kappa^2 and
+with kappa = ``|g''|``, n = g''/kappa, kappa' = g''.g'''/kappa, tau = t.(g'' x g''')/kappa^2 and
 tau' = t.(g'' x g'''')/kappa^2 - 2 tau kappa'/kappa (notes/coaster.md "Frames").  For the table of
 the RMF, omega'' = theta''' t + 2 theta'' g'' + theta' g''' + g'' x g''' + t x g''''.
 
@@ -50,6 +50,7 @@ __all__ = [
     "FrenetFrame",
     "RotationMinimisingFrame",
     "frame_quality",
+    "frame_quality_summary",
 ]
 
 _EZ = np.array([0.0, 0.0, 1.0])
@@ -88,7 +89,7 @@ class Bank:
     def constant(cls, theta=0.0, accept=()):
         """theta(L) = theta (rad; or a string with its unit, ``"30 deg"``).
 
-        A number outside the plausible bank angle (|theta| <= pi, data/coaster/plausible_ranges.csv)
+        A number outside the plausible bank angle (``|theta|`` <= pi, data/coaster/plausible_ranges.csv)
         is refused as a likely slip of degrees (:class:`core.inputs.ImplausibleValueError`);
         ``accept=["bank_angle"]`` takes it deliberately.
         """
@@ -180,7 +181,7 @@ class FrenetFrame(FramedCurve):
         tau' = t.(g'' x g'''')/kappa^2 - 2 tau kappa'/kappa
 
     The frame is undefined where kappa = 0 (straights, inflections).  Where kappa <
-    ``kappa_min`` it raises, unless ``fallback="vertical"``: then n = e_z x t/|e_z x t|, b =
+    ``kappa_min`` it raises, unless ``fallback="vertical"``: then n = e_z x t/``|e_z x t|``, b =
     t x n, omega = omega' = 0 (exact on a straight; on an inflection of a curved track this
     only hides the singularity).  **Inflection flip:** on a planar S-curve n = g''/kappa points
     to the centre of curvature, which changes side at the inflection: n and b flip by 180 deg
@@ -331,9 +332,9 @@ class RotationMinimisingFrame(FramedCurve):
         omega'' = theta''' t + 2 theta'' g'' + theta' g''' + g'' x g''' + t x g''''
 
     With ``bank_reference="frame"`` theta is the given bank (relative to the RMF, which starts
-    with u = the horizontal lateral e_z x t/|e_z x t| unless ``initial_normal`` is given).  With
+    with u = the horizontal lateral e_z x t/``|e_z x t|`` unless ``initial_normal`` is given).  With
     ``bank_reference="vertical"`` the given angle phi is measured from the vertical frame
-    (lateral n_v = e_z x t/|e_z x t|, singular on vertical track) and theta = phi + beta with
+    (lateral n_v = e_z x t/``|e_z x t|``, singular on vertical track) and theta = phi + beta with
     beta the angle from u to n_v about t, beta' = t_z (t x g'')_z/(1 - t_z^2) (= sin(grade)
     times the heading rate), beta'' and beta''' by the quotient rule.
 
@@ -344,7 +345,7 @@ class RotationMinimisingFrame(FramedCurve):
 
     **Table.**  Nodes at the centreline breaks, subdivided to at most ``max_step``; exact
     one-sided values at both ends of every interval (:class:`core.curves.TabulatedFramedCurve`),
-    interpolation error about (h |omega|)^6/46080.
+    interpolation error about (h ``|omega|``)^6/46080.
 
     Parameters
     ----------
@@ -571,14 +572,14 @@ def frame_quality(curve: FramedCurve, centreline: Centreline, L=None, n=1001):
     Columns (SI units in the names):
 
     * ``L_m`` arc length;
-    * ``orthonormality`` max |R^T R - I|;
-    * ``tangent_error`` |t - dg/dL| with dg/dL exact from the centreline;
-    * ``position_error_m`` |r - g|;
-    * ``R_jump`` max |R_i - R_{i-1}| (entrywise) between neighbouring samples (NaN on row 0);
+    * ``orthonormality`` max ``|R^T R - I|``;
+    * ``tangent_error`` ``|t - dg/dL|`` with dg/dL exact from the centreline;
+    * ``position_error_m`` ``|r - g|``;
+    * ``R_jump`` max ``|R_i - R_{i-1}|`` (entrywise) between neighbouring samples (NaN on row 0);
     * ``rotation_step_rad`` the angle of R_{i-1}^T R_i, and ``expected_step_rad`` =
-      |omega| Delta L at the midpoint: a step far above the expected one is a discontinuity
+      ``|omega|`` Delta L at the midpoint: a step far above the expected one is a discontinuity
       (e.g. a Frenet flip, ``rotation_step_rad`` near pi);
-    * ``curvature_1_m`` kappa = |g''| and ``torsion_1_m`` tau = t.(g'' x g''')/kappa^2 (NaN where
+    * ``curvature_1_m`` kappa = ``|g''|`` and ``torsion_1_m`` tau = t.(g'' x g''')/kappa^2 (NaN where
       kappa = 0);
     * ``twist_1_m`` omega . t.
 
@@ -623,3 +624,49 @@ def frame_quality(curve: FramedCurve, centreline: Centreline, L=None, n=1001):
         "torsion_1_m": tau,
         "twist_1_m": _dot(f.omega, R[:, :, 0]),
     })
+
+
+def frame_quality_summary(curve: FramedCurve, centreline: Centreline, step: float = 1.0):
+    """:func:`frame_quality` every ``step`` m along the track, with units in the column names, and
+    its summary.
+
+    The rotation step between neighbouring samples against ``|ω|`` ΔL flags a jump (a ratio of order
+    π/(``|ω|`` ΔL) ≫ 1); the closure max ``|R(length) − R(0)|`` tells whether the frame of a closed track
+    returns to itself.
+
+    Parameters
+    ----------
+    curve : FramedCurve
+    centreline : Centreline
+    step : float
+        Sample spacing (m).
+
+    Returns
+    -------
+    samples : pandas.DataFrame
+        ``L [m]``, ``max |R^T R - I| [-]``, ``|t - g'| [-]``, ``|r - g| [m]``,
+        ``max |R_i - R_i-1| [-]``, ``rotation step [rad]``, ``|omega| dL [rad]``,
+        ``curvature [1/m]``, ``torsion [1/m]``, ``twist omega.t [1/m]``.
+    summary : pandas.DataFrame
+        One row: samples, step, the largest of each error, the largest rotation step and its
+        ratio to ``|ω|`` ΔL, the frame closure, the largest curvature and ``|torsion|``.
+    """
+    q = frame_quality(curve, centreline, L=np.arange(0.0, centreline.length, step))
+    q = q.rename(columns={"L_m": "L [m]", "orthonormality": "max |R^T R - I| [-]", "tangent_error": "|t - g'| [-]",
+                          "position_error_m": "|r - g| [m]", "R_jump": "max |R_i - R_i-1| [-]",
+                          "rotation_step_rad": "rotation step [rad]", "expected_step_rad": "|omega| dL [rad]",
+                          "curvature_1_m": "curvature [1/m]", "torsion_1_m": "torsion [1/m]",
+                          "twist_1_m": "twist omega.t [1/m]"})
+    ratio = (q["rotation step [rad]"] / q["|omega| dL [rad]"]).replace([np.inf, -np.inf], np.nan)
+    end = curve.evaluate(np.array([0.0, centreline.length]))
+    closure = float(np.max(np.abs(end.R[0] - end.R[1])))
+    summary = pd.DataFrame([{
+        "samples [-]": len(q), "step [m]": step,
+        "max |R^T R - I| [-]": q["max |R^T R - I| [-]"].max(), "max |t - g'| [-]": q["|t - g'| [-]"].max(),
+        "max |r - g| [m]": q["|r - g| [m]"].max(),
+        "max rotation step [rad]": q["rotation step [rad]"].max(),
+        "max rotation step / (|omega| dL) [-]": ratio.max(),
+        "frame closure max |R(length) - R(0)| [-]": closure,
+        "max curvature [1/m]": q["curvature [1/m]"].max(),
+        "max |torsion| [1/m]": q["torsion [1/m]"].abs().max()}])
+    return q, summary

@@ -45,7 +45,7 @@ function N(t, q, v) of the state (through the KKT accelerations); along the moti
 (q ⊕ δ the model's retraction, body-frame rotation increments).  This is the exact directional
 derivative of the model's acceleration map along the state's flow, evaluated by a central
 difference in τ: truncation O(ε²) (any path with the same first derivative gives the same
-derivative), round-off O(eps_mach |N| / ε); ε = 1e-5 s gives about 1e-10 g/s on the coaster
+derivative), round-off O(eps_mach ``|N|`` / ε); ε = 1e-5 s gives about 1e-10 g/s on the coaster
 scenes.  It needs two extra KKT solves per output time and no filtering of sampled data.
 
 **Limits and durations.**  ASTM F2291 and EN 13814 give acceleration limits per axis as

@@ -13,7 +13,7 @@ Two kinds of centreline are provided:
 * **Splines through control points** (:class:`SplineCentreline`): cubic C2 (natural, not-a-knot
   or periodic), quintic C4 (not-a-knot or periodic), and shape-preserving C1 (PCHIP or Akima),
   open or closed, fitted in the chord-length parameter u and reparameterised by arc length
-  (Gauss-Legendre quadrature of |g_u| per span, Newton inversion u(L); formulas in the class).
+  (Gauss-Legendre quadrature of ``|g_u|`` per span, Newton inversion u(L); formulas in the class).
 * **Analytic segments** with exact derivatives: :class:`Straight`, :class:`CircularArc`,
   :class:`Helix`, :class:`Clothoid`, :class:`VerticalLoop`, joined into a
   :class:`CompositeCentreline` (use :func:`chain` to place them end to end).
@@ -134,7 +134,7 @@ class Centreline(abc.ABC):
         """:meth:`derivatives` after validation (L finite, 1-D, wrapped if closed)."""
 
     def curvature_torsion(self, L):
-        """Curvature kappa = |g''| (1/m) and torsion tau = g'.(g'' x g''')/kappa^2 (1/m).
+        """Curvature kappa = ``|g''|`` (1/m) and torsion tau = g'.(g'' x g''')/kappa^2 (1/m).
 
         tau is NaN where kappa = 0 (undefined there).
         """
@@ -181,20 +181,20 @@ def _check_spacing(name, chords, closed, accept=()):
 class SplineCentreline(Centreline):
     """Interpolating spline through control points, reparameterised by arc length.
 
-    **Fit.**  The points P_j (m) get chord-length parameters u_0 = 0, u_j = u_{j-1} + |P_j -
-    P_{j-1}| (a closed curve adds the closing chord), and each coordinate is interpolated in u
+    **Fit.**  The points P_j (m) get chord-length parameters u_0 = 0, u_j = u_{j-1} +
+    ``|P_j - P_{j-1}|`` (a closed curve adds the closing chord), and each coordinate is interpolated in u
     with scipy (its interpolators are well-tested, return a ``PPoly`` whose local polynomials we
     evaluate directly, and cover every kind below, so nothing is re-implemented):
 
-    =========== ============================= ========== ================================
-    kind        scipy                          continuity boundary (open / closed)
-    =========== ============================= ========== ================================
-    ``cubic``   ``CubicSpline``                C2         ``bc`` natural or not-a-knot / periodic
-    ``quintic`` ``make_interp_spline(k=5)``    C4         not-a-knot / periodic
-    ``pchip``   ``PchipInterpolator``          C1         one-sided 3-point / wrapped neighbours
-    ``akima``   ``Akima1DInterpolator``        C1         Akima's ends / wrapped neighbours
-    ``makima``  ``Akima1DInterpolator(makima)`` C1        as akima
-    =========== ============================= ========== ================================
+    =========== =============================== ========== =======================================
+    kind        scipy                           continuity boundary (open / closed)
+    =========== =============================== ========== =======================================
+    ``cubic``   ``CubicSpline``                 C2         ``bc`` natural or not-a-knot / periodic
+    ``quintic`` ``make_interp_spline(k=5)``     C4         not-a-knot / periodic
+    ``pchip``   ``PchipInterpolator``           C1         one-sided 3-point / wrapped neighbours
+    ``akima``   ``Akima1DInterpolator``         C1         Akima's ends / wrapped neighbours
+    ``makima``  ``Akima1DInterpolator(makima)`` C1         as akima
+    =========== =============================== ========== =======================================
 
     Shape-preserving kinds act per coordinate: where all three coordinates have a local extremum
     at the same control point the curve has zero speed there (a cusp), which is refused.
@@ -204,7 +204,7 @@ class SplineCentreline(Centreline):
     C1 splines make the curvature jump at every knot, a cubic makes g''' (torsion) jump, a
     quintic is C4.
 
-    **Arc length.**  With the speed s(u) = |g_u| (s_u, s_uu, s_uuu its u-derivatives)::
+    **Arc length.**  With the speed s(u) = ``|g_u|`` (s_u, s_uu, s_uuu its u-derivatives)::
 
         L(u) = L_i + int_{u_i}^{u} s(v) dv          (Gauss-Legendre, n_gauss points per span)
         u <- u - (L(u) - L*) / s(u)                  (Newton inversion, from the chord guess)
@@ -217,7 +217,7 @@ class SplineCentreline(Centreline):
         g_LLLL = g_uuuu u'^4 + 6 g_uuu u'^2 u'' + g_uu (3 u''^2 + 4 u' u''') + g_u u''''
 
     (Faa di Bruno for the inverse function; notes/coaster.md "Frames").  The quadrature error
-    of a panel is of order (Delta u)^(2 n_gauss) |s^(2 n_gauss)|; every span is split into
+    of a panel is of order (Delta u)^(2 n_gauss) ``|s^(2 n_gauss)|``; every span is split into
     ``n_sub`` equal panels, doubled (up to 256) until the total length changes by less than
     1e-13 relative (the last change is kept in ``quadrature_change``).
 
@@ -639,7 +639,7 @@ class Clothoid(Segment):
         g'' = kappa N,  g''' = N/a - kappa^2 T,  g'''' = -3 kappa T/a - kappa^3 N
 
     The position is the standard clothoid c(s) = int_0^s (cos(v^2/2a), sin(v^2/2a)) dv,
-    c(s) = sqrt(pi |a|) (C(z), sgn(a) S(z)), z = s / sqrt(pi |a|) (Fresnel integrals),
+    c(s) = sqrt(pi ``|a|``) (C(z), sgn(a) S(z)), z = s / sqrt(pi ``|a|``) (Fresnel integrals),
     taken from s0 = k0 a and turned so that the local start tangent is x:
     g_loc(L) = Rz(-theta_0) (c(s0 + L) - c(s0)), theta_0 = s0^2/(2a).  Positive curvature
     turns left.  Clothoids in a vertical plane (a clothoid loop) are placed with a rotation
@@ -778,7 +778,7 @@ class Clearance(NamedTuple):
     Attributes
     ----------
     distance : float
-        |g(L_a) - g(L_b)| (m); inf when no pair of non-neighbours came within
+        ``|g(L_a) - g(L_b)|`` (m); inf when no pair of non-neighbours came within
         ``clearance + spacing``.
     L_a, L_b : float
         Arc lengths of the two points (m), L_a < L_b (NaN with distance inf).
@@ -799,7 +799,7 @@ def check_clearance(centreline: Centreline, clearance, spacing=None, raise_error
     """Check that a track does not come back within ``clearance`` of itself (self-intersection).
 
     Two track points g(L_a), g(L_b) are *neighbours* when their along-track separation
-    d(L_a, L_b) = |L_b - L_a| (on a closed track min(|L_b - L_a|, length - |L_b - L_a|)) is at
+    d(L_a, L_b) = ``|L_b - L_a|`` (on a closed track min(``|L_b - L_a|``, length - ``|L_b - L_a|``)) is at
     most the window w = (pi/2) c, c the clearance (e.g. the wheel gauge plus the car's width).
     Non-neighbours must stay at least c apart::
 
@@ -813,7 +813,7 @@ def check_clearance(centreline: Centreline, clearance, spacing=None, raise_error
 
     Method: samples every ``spacing`` (default c/4) into a k-d tree; pairs of non-neighbours
     closer than c + spacing (the most two samples can overestimate a distance) are refined by
-    bounded minimisation of |g(a) - g(b)|^2 in (a, b) with its exact gradient
+    bounded minimisation of ``|g(a) - g(b)|^2`` in (a, b) with its exact gradient
     (d.g'(a), -d.g'(b)), d = g(a) - g(b), within one spacing of the samples.
 
     Parameters
@@ -1112,7 +1112,7 @@ class BankCheck(NamedTuple):
     Attributes
     ----------
     outward_share : float
-        Share of the lateral demand sum |v^2 kappa_h| carried where the bank tilts the riders
+        Share of the lateral demand sum ``|v^2 kappa_h|`` carried where the bank tilts the riders
         outward (0: every turn banked inward; 1: every turn banked outward).
     n_turns, n_outward : int
         Turns (runs of one sign of kappa_h whose peak demand exceeds ``turn_level``) and those
@@ -1121,7 +1121,7 @@ class BankCheck(NamedTuple):
         RMS of the quasi-static lateral load factor at the track f.n/g with the track's bank and
         with flat track (g), over the samples.
     lateral_max_banked, lateral_max_flat : float
-        Largest |f.n|/g with the bank and flat (g).
+        Largest ``|f.n|``/g with the bank and flat (g).
     turns : pandas.DataFrame
         One row per turn: ``L_start [m]``, ``L_end [m]``, ``direction``, ``peak v2k/g [g]``,
         ``mean bank [deg]``, ``outward share [-]``, ``banked``.
@@ -1142,12 +1142,12 @@ def check_bank(frame, speed=None, *, step=1.0, gravity=G_BANK, turn_level=0.1, m
                warn=True) -> BankCheck:
     r"""Compare the sign of a track's bank with the sign of its turns, weighted by v^2 kappa.
 
-    At samples every ``step`` m: t = g', the horizontal lateral n_v = e_z x t/|e_z x t| (left),
+    At samples every ``step`` m: t = g', the horizontal lateral n_v = e_z x t/``|e_z x t|`` (left),
     v_v = t x n_v, the signed lateral curvature kappa_h = g''.n_v (> 0 turning left), the bank
     relative to the vertical phi = atan2(-b.n_v, b.v_v) of the frame's up axis b (> 0 rolls the
     up axis to the right, the convention of :func:`read_circuit`).  A bank tilts the riders
     *into* the turn when b leans towards the centre of curvature (phi kappa_h < 0) and *out of*
-    it when phi kappa_h > 0.  Weights w = v^2 |kappa_h| (the lateral demand of flat track; with
+    it when phi kappa_h > 0.  Weights w = v^2 ``|kappa_h|`` (the lateral demand of flat track; with
     ``speed=None`` the curvature alone)::
 
         outward share = sum w [phi kappa_h > 0, |phi| > min_bank] / sum w
@@ -1250,7 +1250,7 @@ def design_bank(centreline: Centreline, speed, *, step=2.0, gravity=G_BANK, min_
     centreline is f = a - g_vec = v' t + v^2 g'' + g e_z; its part normal to the track,
     f_perp = v^2 g'' + g (e_z - (e_z.t) t), lies in the plane of the up axis b and the lateral
     axis n; the lateral load f.n vanishes when b is parallel to f_perp.  With the horizontal
-    lateral n_v = e_z x t/|e_z x t| and v_v = t x n_v (f_perp.n_v = v^2 kappa_h,
+    lateral n_v = e_z x t/``|e_z x t|`` and v_v = t x n_v (f_perp.n_v = v^2 kappa_h,
     f_perp.v_v = v^2 kappa_v + g cos(gamma), kappa_h = g''.n_v, kappa_v = g''.v_v, gamma the
     grade)::
 

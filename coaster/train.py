@@ -30,10 +30,10 @@ joint                      what it fixes                                   equat
 given both pivot points keeps only its rotation about the pivot line P_f − P_r; the universal's
 dot row fixes it, and its gradient with respect to that rotation is (x_car × y_car)·b_r =
 z_car·b_r ≈ 1 (never small while the car stands on the track).  The remaining three point rows
-of the two pivots are one scalar condition on (L_f, L_r): |P_f(L_f) − P_r(L_r)| = 2a, whose
+of the two pivots are one scalar condition on (L_f, L_r): ``|P_f(L_f) − P_r(L_r)|`` = 2a, whose
 derivative along the track, (P_f − P_r)/2a · t, is ≈ 1 as long as the chord between the pivots
 points along the track.  A bar given its front end keeps two directions and its spin; the rear
-point fixes the direction up to one scalar condition |C_k − C'_{k+1}| = l_b on the cars it
+point fixes the direction up to one scalar condition ``|C_k − C'_{k+1}|`` = l_b on the cars it
 joins, its dot row fixes the spin (gradient (x_bar × y_bar)·z_car ≈ 1).  So the 71 equations are
 three car chords + two bar lengths = five conditions on the six L_i, plus rows that each fix
 one body freedom with an O(1) gradient: rank 71 everywhere on a track whose radius is large
@@ -47,10 +47,10 @@ Assembly
 --------
 Given the lead arc length L_1 (:meth:`Train.state_at`): each wheelset at its L_i takes the
 track frame (A = R(L_i), r = g(L_i)); car k with its front wheelset at L_f has its rear
-wheelset at the L_r < L_f with |P(L_f) − P(L_r)| = 2a (P(L) = g + z_p b, a 1-D root by
-Brent's method), x_car = (P_f − P_r)/2a, y_car = b_r × x_car/|b_r × x_car|, z_car = x_car ×
+wheelset at the L_r < L_f with ``|P(L_f) − P(L_r)|`` = 2a (P(L) = g + z_p b, a 1-D root by
+Brent's method), x_car = (P_f − P_r)/2a, y_car = b_r × x_car/``|b_r × x_car|``, z_car = x_car ×
 y_car, r_car = P_f − A_car (a, 0, −d).  The next car's front arc length solves
-|C_k − C'_{k+1}(L)| = l_b (an outer 1-D root over the inner one).  Velocities at lead speed
+``|C_k − C'_{k+1}(L)|`` = l_b (an outer 1-D root over the inner one).  Velocities at lead speed
 v: the unique solution of [Φ_q; e_{L1}ᵀ] v = [ν; v] (71 + 1 rows, square and regular).
 
 Forces along the track (:class:`TrackForces`)
@@ -129,8 +129,12 @@ __all__ = [
     "wheel_force_peaks",
     "time_above_limits_dense",
     "rank_table",
+    "sections_at",
+    "section_summary",
     "circuit_frame",
+    "CIRCUIT_SETTINGS",
     "circuit_sections",
+    "named_sections",
     "G",
 ]
 
@@ -997,6 +1001,62 @@ class TrainRun:
                 ph[j], Q[j], Vv[j] = k, qq, vv
         return ph, Q, Vv, T
 
+    def rider_loads(self, car: str = "car1", rider_point=None, jerk: bool = True) -> pd.DataFrame:
+        """Load factors and jerk at a rider over every phase of the run, one row per output.
+
+        :func:`coaster.rider.rider_loads` of each phase's model (n = Cᵀ Aᵀ (a_P − g_vec)/g in
+        car axes x forward, y left, z up), the rows of all phases concatenated.
+
+        Parameters
+        ----------
+        car : str
+            Car body of the rider.
+        rider_point : (3,) array_like, optional
+            Rider point in car axes (m); default the train's ``rider_point``.
+        jerk : bool
+            Compute the jerk columns (two more solves per row).
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``t [s]``, ``L [m]`` (lead arc length), ``n_x [g]`` … ``n_z [g]``, with ``jerk`` the
+            columns ``jerk_x [g/s]`` … ``jerk_z [g/s]``, and ``v_P [m/s]``.
+        """
+        from types import SimpleNamespace
+
+        from .rider import rider_loads
+
+        rp = self.train.p.rider_point if rider_point is None else rider_point
+        parts = []
+        for k, model in enumerate(self.models):
+            sel = np.flatnonzero(self.phase == k)
+            if not len(sel):
+                continue
+            res = SimpleNamespace(t=self.t[sel], q=self.q[sel], v=self.v[sel], meta=self.meta, status=self.status)
+            parts.append(rider_loads(model, res, car, rp, coordinate=self.train.coordinates[0], jerk=jerk))
+        return pd.concat(parts, ignore_index=True)
+
+    def energy_drift(self, L_end: float) -> tuple[float, float, float, float]:
+        """Energy drift of the free run (the last phase) up to lead arc length ``L_end``.
+
+        drift = max ``|E − E_0|`` / T_peak over the outputs of the last phase with L_1 < ``L_end``,
+        E = T + V (:meth:`energy`), T_peak = ½ M_e max L̇_1² with the effective mass M_e = total
+        mass + n_wheelsets × wheel spin mass.  Without dissipative forces before ``L_end`` the
+        drift measures the integration error.
+
+        Returns
+        -------
+        (drift [-], t from [s], t to [s], T_peak [J])
+        """
+        E = self.energy()
+        sel = (self.phase == len(self.models) - 1) & (self.L[:, 0] < L_end)
+        if not np.any(sel):
+            raise InputError(f"energy_drift: no output of the free run before L = {L_end!r} m")
+        p = self.train.p
+        T_peak = 0.5 * (p.total_mass + p.n_wheelsets * p.wheel_spin_mass) * float(np.max(self.Ldot[sel, 0]) ** 2)
+        Es = E[sel]
+        return float(np.max(np.abs(Es - Es[0])) / T_peak), float(self.t[sel][0]), float(self.t[sel][-1]), T_peak
+
     def table(self) -> pd.DataFrame:
         """Lead arc length, speed, acceleration along the track, height, energy, phase: one row per output."""
         m = self.models[0]
@@ -1048,11 +1108,37 @@ def _accelerations(model, T, Q, V):
 
 
 def _section_at(sections: pd.DataFrame | None, L: float, period: float) -> str:
-    if sections is None or len(sections) == 0:
-        return "track"
-    x = L % period if period > 0 else L
-    hit = sections[(sections["L_start [m]"] <= x) & (x < sections["L_end [m]"])]
-    return str(hit["section"].iloc[0]) if len(hit) else "track"
+    return str(sections_at(sections, [L], period)[0])
+
+
+def sections_at(sections: pd.DataFrame | None, L, period: float = 0.0) -> np.ndarray:
+    """The name of the track section at each arc length.
+
+    Section i covers L_start,i ≤ x < L_end,i with x = L mod ``period`` on a closed track
+    (``period`` its length) and x = L on an open one (``period`` = 0).
+
+    Parameters
+    ----------
+    sections : pandas.DataFrame or None
+        ``section``, ``L_start [m]``, ``L_end [m]`` (:func:`circuit_sections`).
+    L : (n,) array_like
+        Arc lengths (m).
+    period : float
+        Length of a closed track (m), 0 for an open one.
+
+    Returns
+    -------
+    (n,) ndarray of str (object)
+        The section's name, ``"track"`` where no section covers L (or without sections).
+    """
+    L = np.atleast_1d(np.asarray(L, float))
+    x = np.mod(L, period) if period > 0 else L
+    out = np.full(len(x), "track", dtype=object)
+    if sections is None:
+        return out
+    for _, row in sections.iloc[::-1].iterrows():  # the first covering row wins
+        out[(x >= row["L_start [m]"]) & (x < row["L_end [m]"])] = str(row["section"])
+    return out
 
 
 @checked_options
@@ -1242,7 +1328,7 @@ def _section_labels(run: TrainRun, sections: pd.DataFrame | None):
     period = float(run.train.track.length) if getattr(run.train.track, "closed", False) else 0.0
     if sections is None:
         return period, np.array(["all"] * len(run.t), dtype=object), {}
-    labels = np.array([_section_at(sections, x, period) for x in run.L[:, 0]], dtype=object)
+    labels = sections_at(sections, run.L[:, 0], period)
     bounds = {str(r["section"]): (float(r["L_start [m]"]), float(r["L_end [m]"])) for _, r in sections.iterrows()}
     return period, labels, bounds
 
@@ -1447,7 +1533,7 @@ def rider_peaks(run: TrainRun, car: str = "car1", rider_point=None, sections: pd
 def wheel_force_peaks(run: TrainRun, sections: pd.DataFrame | None = None, n_fine: int = 12) -> pd.DataFrame:
     """Extreme wheel forces over all wheelsets per track section, independent of the output step.
 
-    :func:`section_extremes` of max_i F_b,i, min_i F_b,i and max_i |F_n,i| over the wheelsets
+    :func:`section_extremes` of max_i F_b,i, min_i F_b,i and max_i ``|F_n,i|`` over the wheelsets
     (the path joints' reactions in the track frame, :func:`wheel_forces`).
 
     Returns
@@ -1707,7 +1793,7 @@ def circuit_frame(bank: bool = True, max_step: float = 2.0):
 def circuit_sections(data=None, centreline=None) -> pd.DataFrame:
     """Named sections of the circuit as arc-length ranges: one row per run of equal names.
 
-    A control point's section covers [L_i, L_{i+1}); the last run ends at the circuit length.
+    :func:`named_sections` of the circuit's section names (default: the shared circuit).
 
     Returns
     -------
@@ -1717,8 +1803,33 @@ def circuit_sections(data=None, centreline=None) -> pd.DataFrame:
     """
     if data is None or centreline is None:
         _, data, centreline = circuit_frame()
+    return named_sections(data.section, centreline)
+
+
+def named_sections(names, centreline) -> pd.DataFrame:
+    """Track sections as arc-length ranges from a section name per control point.
+
+    Control point i's section covers [L_i, L_{i+1}) (L_i its arc length, ``centreline.L_points``);
+    a run of equal names i … j is one section [L_i, L_{j+1}), the last run ends at the track's
+    length (closed or open).
+
+    Parameters
+    ----------
+    names : (N,) sequence of str
+        Section name of each control point.
+    centreline : coaster.track.SplineCentreline
+        The spline through the N control points.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``section``, ``L_start [m]``, ``L_end [m]``, ``length [m]``, ``z_start [m]``, ``z_end [m]``,
+        ``z_max [m]``, ``z_min [m]`` (heights from 200 samples of the section).
+    """
+    names = [str(n) for n in names]
+    if len(names) != len(centreline.L_points):
+        raise InputError(f"named_sections: {len(names)} names for {len(centreline.L_points)} control points")
     Lp = np.append(centreline.L_points, centreline.length)
-    names = list(data.section)
     rows = []
     i = 0
     while i < len(names):
@@ -1731,4 +1842,68 @@ def circuit_sections(data=None, centreline=None) -> pd.DataFrame:
                      "length [m]": float(Lp[j + 1] - Lp[i]), "z_start [m]": float(z[0]), "z_end [m]": float(z[-1]),
                      "z_max [m]": float(z.max()), "z_min [m]": float(z.min())})
         i = j + 1
+    return pd.DataFrame(rows)
+
+
+#: Operating settings of the circuit scene (SI units): chain, booster and brake speed controls,
+#: the dissipative run's rolling resistance and drag, and the integrator.
+CIRCUIT_SETTINGS = dict(
+    chain_speed=8.0,          # m/s on the Lift section
+    booster_speed=22.0,       # m/s target of the Launch section (linear synchronous motors)
+    booster_force=40.0e3,     # N
+    brake_speed=6.0,          # m/s target of the Brake section
+    brake_force=30.0e3,       # N
+    gain=2.0e4,               # N s/m of both speed controls
+    rolling=0.0025,           # c_rr of the dissipative run
+    drag_area=1.2,            # c_d A (m²) of the dissipative run
+    rtol=1e-8,
+    atol=1e-8,
+    method="jit-dop853-projection",
+)
+
+
+def section_summary(loads: pd.DataFrame, rider: pd.DataFrame, wheels: pd.DataFrame,
+                    above: pd.DataFrame) -> pd.DataFrame:
+    """Per track section: time spent, peak rider loads and wheel forces, the limits exceeded.
+
+    The peaks come from :func:`rider_peaks` and :func:`wheel_force_peaks` (independent of the
+    output step); the time in a section is the sum of the output steps that start in it, the
+    largest ``|jerk_z|`` is read on the outputs.
+
+    Parameters
+    ----------
+    loads : pandas.DataFrame
+        :meth:`TrainRun.rider_loads` with a ``section`` column (:func:`sections_at` of ``L [m]``).
+    rider : pandas.DataFrame
+        :func:`rider_peaks` of the run per section.
+    wheels : pandas.DataFrame
+        :func:`wheel_force_peaks` of the run per section.
+    above : pandas.DataFrame
+        :func:`time_above_limits_dense` (or :func:`coaster.rider.time_above_limits`) per section.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per section in the order of the run: ``time in section [s]``, ``n_z max [g]``,
+        ``n_z min [g]``, ``|n_y| max [g]``, ``n_x max [g]``, ``n_x min [g]``, ``|jerk_z| max [g/s]``,
+        ``F_b max [kN]``, ``F_b min [kN]``, ``|F_n| max [kN]``, ``limits exceeded``.
+    """
+    rows = []
+    t = loads["t [s]"].to_numpy()
+    labels = loads["section"].to_numpy()
+    pk = rider.set_index("section")
+    wk = wheels.set_index("section")
+    for name in dict.fromkeys(labels):
+        m = labels == name
+        p, w = pk.loc[name], wk.loc[name]
+        exceeded = above[(above["section"] == name) & (above["verdict"] == "exceeds")]
+        rows.append({
+            "section": name, "time in section [s]": float(np.sum(np.diff(t)[m[:-1]])),
+            "n_z max [g]": p["n_z max [g]"], "n_z min [g]": p["n_z min [g]"],
+            "|n_y| max [g]": p["|n_y| max [g]"], "n_x max [g]": p["n_x max [g]"],
+            "n_x min [g]": p["n_x min [g]"],
+            "|jerk_z| max [g/s]": loads["jerk_z [g/s]"][m].abs().max(),
+            "F_b max [kN]": w["F_b max [kN]"], "F_b min [kN]": w["F_b min [kN]"], "|F_n| max [kN]": w["|F_n| max [kN]"],
+            "limits exceeded": ", ".join(f"{r['axis']} {r['level [g]']:+g} g" for _, r in exceeded.iterrows()) or "none",
+        })
     return pd.DataFrame(rows)

@@ -380,7 +380,7 @@ def static_equilibrium(system: ConstrainedSystem, q_guess: ArrayLike | None = No
       (local minimum of the potential on the constraint manifold) from a rough guess.
     * ``'newton'``: the full step above with backtracking on the residual norm; converges to the
       nearest stationary point, stable or not (follower loads, non-conservative systems).  Newton finds *a* stationary point; ``result.stable`` tells whether it is a
-    minimum.
+      minimum.
 
     Parameters
     ----------

@@ -3,8 +3,9 @@
 Commands::
 
     mbsuite list                              scenes with their titles
-    mbsuite run NAME [NAME ...] [-o OUT] [--fast] [--workers N | --dask ADDRESS]
-    mbsuite run --all [-o OUT] [--fast]       every scene, into OUT/<scene name>/
+    mbsuite run NAME [NAME ...] [-o OUT] [--fast|--full] [--workers N | --dask ADDRESS]
+    mbsuite run --all [-o OUT] [--fast|--full]  every scene, into OUT/<scene name>/; OUT/README.md
+                                              indexes every scene folder in OUT
     mbsuite bench [PROBLEM ...] [--methods M ...] [--repeats N] [--quick|--full] [-j N] [-o OUT]
     mbsuite bench --list                      work-precision problems and methods (core.benchmarks)
     mbsuite --version
@@ -49,7 +50,7 @@ from pathlib import Path
 from . import __version__
 from .errors import RUN_FAILURES, InputError, MbsuiteError
 from .paths import output_folder
-from .scenes import Scene, SceneError, all_scenes, run_scene, tqdm_progress
+from .scenes import Scene, SceneError, all_scenes, run_scene, tqdm_progress, write_index
 
 __all__ = ["COMMAND_ENTRY_POINT_GROUP", "Parser", "UsageError", "build_parser", "check_option", "main"]
 
@@ -174,13 +175,6 @@ def _cmd_list(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _write_index(out_dir: Path, outcomes: dict[str, tuple[Scene, str]]) -> None:
-    lines = ["# mbsuite output", "", "| scene | title | status |", "|---|---|---|"]
-    for name, (scene, status) in outcomes.items():
-        lines.append(f"| [{name}]({name}/README.md) | {scene.title} | {status} |")
-    (out_dir / "README.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
-
-
 def _cmd_run(args: argparse.Namespace) -> int:
     parser: argparse.ArgumentParser = args._parser
     if args.all and args.names:
@@ -209,13 +203,19 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _sweep_executor(args: argparse.Namespace):
-    """The executor of the scenes' sweeps: serial (None), a local process pool (``--workers N``)
-    or a dask.distributed cluster (``--dask ADDRESS``, extra ``mbsuite[parallel]``)."""
+    """The executor of the scenes' sweeps: a local process pool on every core (default; ``--workers
+    N`` for N processes, ``--workers 1`` serial in this process) or a dask.distributed cluster
+    (``--dask ADDRESS``, extra ``mbsuite[parallel]``). The pool starts its processes only when a
+    sweep submits work."""
     import contextlib
     import concurrent.futures
 
     if args.workers is not None and args.dask is not None:
         raise InputError("give --workers or --dask, not both")
+    if args.workers is None and args.dask is None:
+        import os
+
+        args.workers = os.cpu_count() or 1
     if args.workers is not None:
         if args.workers < 1:
             raise InputError(f"--workers {args.workers}: give a number of processes >= 1")
@@ -225,6 +225,8 @@ def _sweep_executor(args: argparse.Namespace):
         if args.workers > 4 * cpus:
             raise InputError(f"--workers {args.workers}: this machine has {cpus} processor(s); more than "
                              f"{4 * cpus} processes only slow the sweep down (use --dask for a cluster)")
+        if args.workers == 1:
+            return contextlib.nullcontext(None)
         return concurrent.futures.ProcessPoolExecutor(max_workers=args.workers)
     if args.dask is not None:
         if ":" not in args.dask:
@@ -249,30 +251,30 @@ def _sweep_executor(args: argparse.Namespace):
 
 
 def _run_selected(selected, out_dir, args, executor, tqdm) -> int:
-    outcomes: dict[str, tuple[Scene, str]] = {}
     failed: list[str] = []
+    begin = time.perf_counter()
     bar = tqdm(selected, desc="scenes", unit="scene", disable=None)
     for scene in bar:
         bar.set_postfix_str(scene.name)
         start = time.perf_counter()
         try:
-            result = run_scene(scene, out_dir, fast=args.fast, progress=tqdm_progress, executor=executor)
+            result = run_scene(scene, out_dir, mode=args.mode, progress=tqdm_progress, executor=executor,
+                               workers=args.workers or 1)
         except SceneError as exc:
             failed.append(scene.name)
-            outcomes[scene.name] = (scene, "failed")
             tqdm.write(f"FAILED {scene.name}: {exc}", file=sys.stderr)
             continue
-        outcomes[scene.name] = (scene, "ok")
         tqdm.write(
             f"ok     {scene.name} -> {out_dir / scene.name} "
             f"({len(result.tables)} tables, {len(result.figures)} figures, {time.perf_counter() - start:.1f} s)"
         )
     bar.close()
-    _write_index(out_dir, outcomes)
+    write_index(out_dir)
     if failed:
         print(f"mbsuite: {len(failed)} of {len(selected)} scene(s) failed: {', '.join(failed)}", file=sys.stderr)
         return EXIT_FAILURE
-    print(f"mbsuite: {len(selected)} scene(s) written to {out_dir}")
+    print(f"mbsuite: {len(selected)} scene(s) written to {out_dir} in {time.perf_counter() - begin:.0f} s "
+          f"(mode {args.mode}); index: {out_dir / 'README.md'}")
     return EXIT_OK
 
 
@@ -389,9 +391,14 @@ def build_parser() -> argparse.ArgumentParser:
     p_run.add_argument("names", nargs="*", metavar="NAME", help="scene name(s), see `mbsuite list`")
     p_run.add_argument("--all", action="store_true", help="run every available scene")
     p_run.add_argument("-o", "--out", default="out", help="output folder (default: %(default)s)")
-    p_run.add_argument("--fast", action="store_true", help="reduced resolution (smoke test)")
+    modes = p_run.add_mutually_exclusive_group()
+    modes.add_argument("--fast", dest="mode", action="store_const", const="fast", default="default",
+                       help="reduced resolution (smoke test)")
+    modes.add_argument("--full", dest="mode", action="store_const", const="full",
+                       help="also the exhaustive computations (each scene's README says what this adds)")
     p_run.add_argument("--workers", type=int, default=None, metavar="N",
-                       help="run the scenes' parameter sweeps on N local processes (default: serial)")
+                       help="run the scenes' parameter sweeps on N local processes (default: one per core; "
+                            "1 = serially in this process)")
     p_run.add_argument("--dask", default=None, metavar="ADDRESS",
                        help="run the scenes' parameter sweeps on a dask.distributed scheduler "
                             "(e.g. tcp://host:8786; extra mbsuite[parallel])")

@@ -2,7 +2,7 @@ r"""Contact laws of two elastic bodies: Hertz from principal curvatures, and con
 laws with hysteresis damping (Lankarani–Nikravesh, Flores et al., Hunt–Crossley).
 
 One definition for every package: :class:`core.forces.contact.PlaneContact` and the railway
-wheel–rail contact (:mod:`railway.forces`, :mod:`railway.quasi_static`, :mod:`railway.creep_curve`)
+wheel–rail contact (:mod:`railway.contact.forces`, :mod:`railway.contact.quasi_static`, :mod:`railway.contact.creep_curve`)
 use these functions; the compiled railway kernel evaluates the same equations and is tested
 against them.
 
@@ -296,7 +296,7 @@ def ellipse_ratio(curvature_ratio, n_iter: int = 200) -> np.ndarray:
 def hertz_coefficients(cos_theta):
     """Hertz coefficients m, n (Timoshenko & Goodier's notation) and g = n/m from cos(theta).
 
-    cos(theta) = |B - A|/(A + B); g from (H2) with B'/A' = (1 + cos theta)/(1 - cos theta);
+    cos(theta) = ``|B - A|``/(A + B); g from (H2) with B'/A' = (1 + cos theta)/(1 - cos theta);
     m = (2 E(e)/(pi g^2))^(1/3), n = m g, Eq. (H3).
 
     Parameters

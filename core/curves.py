@@ -88,7 +88,7 @@ def quintic_hermite_coeffs(h, f0, f1, f2, g0, g1, g2):
 
     Returns
     -------
-    (*S, 6) ndarray
+    ``(*S, 6)`` ndarray
         Coefficients c0 ... c5 along the last axis.
     """
     h = np.asarray(h, dtype=float)
@@ -372,8 +372,8 @@ class FramedCurve(abc.ABC):
         """Arc lengths of the curve points nearest to ``points`` (foot of the perpendicular).
 
         Solves f(s) = (p - r(s)) . r'(s) = 0 by Newton's method from ``s_guess`` (vectorised
-        over the points), with f'(s) = -|r'|^2 + (p - r) . r''; a Newton step is limited to
-        a quarter of the distance |p - r| + 1 m, so that a guess far along the curve walks in
+        over the points), with f'(s) = -``|r'|^2`` + (p - r) . r''; a Newton step is limited to
+        a quarter of the distance ``|p - r|`` + 1 m, so that a guess far along the curve walks in
         instead of jumping.  The foot of the perpendicular is unique and the iteration converges
         from any guess within the curve's radius of curvature of the point (a point within a
         few metres of a track of radius >= 100 m converges from any guess within tens of
@@ -453,8 +453,8 @@ class TabulatedFramedCurve(FramedCurve):
 
     One evaluation of the table gives r, r', r'', R, omega and omega' (``evaluate_raw``).  The
     error of each component is at most max|f^(6)| h^6 / 46080.  R is interpolated entrywise, so
-    it is orthonormal and ``dR/ds = [omega]x R`` holds only to that error: with |R^(6)| ~
-    |omega|^6, about (h |omega|)^6 / 46080, i.e. round-off for h |omega| below about 0.015
+    it is orthonormal and ``dR/ds = [omega]x R`` holds only to that error: with ``|R^(6)|`` ~
+    ``|omega|^6``, about (h ``|omega|``)^6 / 46080, i.e. round-off for h ``|omega|`` below about 0.015
     (2 m intervals on a 150 m radius).  Outside [s_0, s_n] an open curve is extrapolated with the
     end pieces; a closed curve takes s modulo its length.
 

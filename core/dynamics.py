@@ -27,7 +27,7 @@ positions and velocities are the minimum-``W``-norm solutions of ``Φ_q Δ = r``
 (:func:`minimum_norm_correction`, ``W = M`` or ``I``).
 
 Projection onto the constraint manifold (Eich 1993; Eich-Soellner & Führer 1998, Ch. 5)
---------------------------------------------------------------------------------------
+---------------------------------------------------------------------------------------
 :func:`project_positions`: simplified Gauss–Newton iterations for the M-weighted minimum-norm
 correction along velocity-space increments,
 

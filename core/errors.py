@@ -16,22 +16,22 @@ scipy, or as a :class:`DataRangeError` when a run goes past the end of a measure
 other exception, e.g. a programming error in a user's force element, is *not* a run failure and
 propagates with its traceback.
 
-=========================== ============================ =============================================
-class                       also a                       raised when
-=========================== ============================ =============================================
-:class:`MbsuiteError`       ``Exception``                base class, never raised itself
-:class:`InputError`         ``ValueError``               a value, option or argument cannot be used
-:class:`UnknownOptionError` ``ValueError``, ``TypeError`` an option that is not accepted (lists them)
-:class:`ModelError`         ``ValueError``               a model definition is invalid (names the element)
-:class:`RedundantConstraintError` ``ValueError``         dependent constraint equations (lists them)
-:class:`AssemblyError`      ``ValueError``               the configuration cannot be assembled
-:class:`DataFileError`      ``ValueError``               a data file is missing or malformed (names it)
-:class:`DataRangeError`     ``ValueError``               tabulated input evaluated outside its range
-:class:`UnknownNameError`   ``ValueError``               a registry has no entry of that name
-:class:`NameTakenError`     ``ValueError``               a registry name is taken by another object
-:class:`NotCompilable`      ``TypeError``                a model has an element without a compiled kernel
-:class:`NumericalFailure`   ``ArithmeticError``          inside a step: the step cannot be completed
-=========================== ============================ =============================================
+================================= ============================= =================================================
+class                             also a                        raised when
+================================= ============================= =================================================
+:class:`MbsuiteError`             ``Exception``                 base class, never raised itself
+:class:`InputError`               ``ValueError``                a value, option or argument cannot be used
+:class:`UnknownOptionError`       ``ValueError``, ``TypeError`` an option that is not accepted (lists them)
+:class:`ModelError`               ``ValueError``                a model definition is invalid (names the element)
+:class:`RedundantConstraintError` ``ValueError``                dependent constraint equations (lists them)
+:class:`AssemblyError`            ``ValueError``                the configuration cannot be assembled
+:class:`DataFileError`            ``ValueError``                a data file is missing or malformed (names it)
+:class:`DataRangeError`           ``ValueError``                tabulated input evaluated outside its range
+:class:`UnknownNameError`         ``ValueError``                a registry has no entry of that name
+:class:`NameTakenError`           ``ValueError``                a registry name is taken by another object
+:class:`NotCompilable`            ``TypeError``                 a model has an element without a compiled kernel
+:class:`NumericalFailure`         ``ArithmeticError``           inside a step: the step cannot be completed
+================================= ============================= =================================================
 """
 
 from __future__ import annotations

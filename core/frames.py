@@ -201,7 +201,7 @@ def quat_multiply(p: ArrayLike, r: ArrayLike) -> NDArray[np.float64]:
 
 
 def rotation_vector_to_euler(theta: ArrayLike) -> NDArray[np.float64]:
-    """Exponential map: Euler parameters of the rotation vector ``θ`` (angle |θ| about θ/|θ|).
+    """Exponential map: Euler parameters of the rotation vector ``θ`` (angle ``|θ|`` about θ/``|θ|``).
 
     Uses the series of sin(x/2)/x near zero so that small increments are exact to round-off.
 

@@ -55,6 +55,7 @@ __all__ = [
     "simple_pendulum",
     "double_pendulum",
     "slider_crank",
+    "crank_geometry",
     "four_bar",
     "n_link_chain",
     "chain_tip",
@@ -390,14 +391,49 @@ def slider_crank(crank_angle0: float = 0.0, crank_speed: float = 150.0, driven: 
     return b.build()
 
 
+def crank_geometry(model: Model) -> tuple[float, float]:
+    r"""Crank radius and connecting-rod length of a slider crank, read from its joint locations.
+
+    With the crank pivot O at the origin, the crank pin A and the wrist pin B (the revolute
+    joints of :func:`slider_crank`, at their positions in the model's initial configuration)::
+
+        r = |A − O|,     l = |B − A|
+
+    which enter the closed-form slider position ``x(θ) = r cos θ + √(l² − r² sin² θ)``.
+
+    Parameters
+    ----------
+    model : Model
+        A slider crank built by :func:`slider_crank` (crank pivot at the origin).
+
+    Returns
+    -------
+    r : float
+        Crank radius [m] (``l1``).
+    l : float
+        Connecting-rod length [m] (``l2``).
+
+    References
+    ----------
+    B. Simeon, Math. Modelling of Systems 2 (1996) 1–18 (the geometry, ``l1 = 0.15``,
+    ``l2 = 0.30`` m); the position equation is the loop closure of the crank, rod and slider.
+    """
+    pins = {j.name: np.asarray(j.at, float) for j in model.joints if type(j).__name__ == "Revolute"}
+    # crank pivot at the origin; the crank pin is the nearer of the other two revolutes
+    others = [p for p in pins.values() if np.linalg.norm(p) > 1e-12]
+    a = min(others, key=lambda p: np.linalg.norm(p))
+    b = max(others, key=lambda p: np.linalg.norm(p))
+    return float(np.linalg.norm(a)), float(np.linalg.norm(b - a))
+
+
 def four_bar(ground: float = 0.4, crank: float = 0.1, coupler: float = 0.35, rocker: float = 0.3,
              mass_per_length: float = 1.0, crank_angle0: float = np.pi / 2, crank_rate0: float = 2 * np.pi,
              crank_speed: float | None = None, gravity: float = G_EARTH) -> Model:
     r"""Planar four-bar linkage of uniform slender links (default: a Grashof crank–rocker).
 
     Geometry: ground pivots O2 = (0, 0) and O4 = (``ground``, 0); crank O2–A at absolute angle
-    θ2, coupler A–B, rocker O4–B; B is the intersection of the circles |B − A| = coupler and
-    |B − O4| = rocker on the left of A→O4 (the "open" assembly, B above the line A–O4).  Each
+    θ2, coupler A–B, rocker O4–B; B is the intersection of the circles ``|B − A|`` = coupler and
+    ``|B − O4|`` = rocker on the left of A→O4 (the "open" assembly, B above the line A–O4).  Each
     link is a uniform slender rod of mass ``mass_per_length · length`` and ``J = m l²/12``.
     Grashof's condition ``s + l ≤ p + q`` with the crank the shortest link makes it a
     crank–rocker (defaults 0.1 + 0.4 ≤ 0.35 + 0.3): the crank turns fully and Φ_q never loses rank.
@@ -790,10 +826,10 @@ def andrews_cartesian(**overrides: float) -> Model:
 
     References
     ----------
-    E. Hairer, G. Wanner, *Solving ODEs II*, 2nd ed., Springer, 1996, Sec. VII.7, pp. 530–536.
-    F. Mazzia, C. Magherini, *Test Set for IVP Solvers* 2.4, Univ. of Bari, 2008, "andrews".
-    W. Schiehlen (ed.), *Multibody Systems Handbook*, Springer, 1990 (Manning & Giles,
-    Andrews & Richard: "seven body mechanism"); IFToMM benchmark A03.
+    - E. Hairer, G. Wanner, *Solving ODEs II*, 2nd ed., Springer, 1996, Sec. VII.7, pp. 530–536.
+    - F. Mazzia, C. Magherini, *Test Set for IVP Solvers* 2.4, Univ. of Bari, 2008, "andrews".
+    - W. Schiehlen (ed.), *Multibody Systems Handbook*, Springer, 1990 (Manning & Giles,
+      Andrews & Richard: "seven body mechanism"); IFToMM benchmark A03.
     """
     from .benchmarks.testset import ANDREWS_PARAMETERS, AndrewsSqueezer
     from .forces import AppliedTorque, SpringDamper

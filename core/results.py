@@ -26,6 +26,7 @@ import importlib.metadata
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from collections.abc import Sequence
 from typing import Any, Literal, NamedTuple
 
 import numpy as np
@@ -71,7 +72,7 @@ def _check_stem(stem: str) -> str:
 
 
 def write_table(
-    df: pd.DataFrame, out_dir: str | Path, stem: str, floatfmt: str = ".6g"
+    df: pd.DataFrame, out_dir: str | Path, stem: str, floatfmt: str = ".6g", record=None
 ) -> dict[str, Path]:
     """Write a DataFrame as ``<stem>.csv`` and ``<stem>.md`` into ``out_dir``.
 
@@ -91,11 +92,14 @@ def write_table(
         File name without suffix.
     floatfmt : str, optional
         Format spec for floats in the Markdown table (passed to tabulate).
+    record : core.provenance.RunRecord, optional
+        How the table was computed: written as ``<stem>.csv-metadata.json`` (CSVW) and as a line
+        under the Markdown table.
 
     Returns
     -------
     dict of str to Path
-        ``{"csv": path, "md": path}``.
+        ``{"csv": path, "md": path}``, and ``"metadata"`` when ``record`` is given.
     """
     if not isinstance(df, pd.DataFrame):
         raise TypeError(f"write_table({stem!r}): expected a pandas DataFrame, got {type(df).__name__}")
@@ -105,9 +109,18 @@ def write_table(
     csv_path = out / f"{stem}.csv"
     md_path = out / f"{stem}.md"
     md = markdown_table(df, index=keep_index, floatfmt=floatfmt) + "\n"
+    if record is not None:
+        md += "\n" + record.markdown_line() + "\n"
     write_atomically(csv_path, lambda p: df.to_csv(p, index=keep_index))
     write_atomically(md_path, lambda p: p.write_text(md, encoding="utf-8"))
-    return {"csv": csv_path, "md": md_path}
+    paths = {"csv": csv_path, "md": md_path}
+    if record is not None:
+        import json
+
+        meta = json.dumps(record.csvw(csv_path.name, title=stem), indent=2, ensure_ascii=False) + "\n"
+        paths["metadata"] = write_atomically(out / f"{stem}.csv-metadata.json",
+                                             lambda p: p.write_text(meta, encoding="utf-8"))
+    return paths
 
 
 def _escape_cell(x):
@@ -278,6 +291,31 @@ class AcceptedSteps(NamedTuple):
     v: np.ndarray
 
 
+def search_states_at_steps(result, names: Sequence[str]) -> np.ndarray | None:
+    """The search state a stateful force kind had after every accepted step of a compiled run.
+
+    ``simulate(..., record_steps=True)`` on a compiled integrator keeps, beside
+    :class:`AcceptedSteps`, the search state of every force kind that keeps one (a contact
+    search's tracked points), in ``result.step_search_states`` by the kind's element names.  A quantity evaluated afterwards at step ``k`` with the state of row ``k`` sees the
+    contacts the run used from that step on, with no need to carry the search along the run again.
+
+    Parameters
+    ----------
+    result : SimulationResult
+    names : sequence of str
+        The element names of the kind (its compiled record's ``names``).
+
+    Returns
+    -------
+    ndarray, shape (n_steps + 1, n_elements, width), or None
+        None when the run recorded no states (numpy integrators, or ``record_steps=False``).
+    """
+    states = getattr(result, "step_search_states", None)
+    if not states:
+        return None
+    return states.get(tuple(names))
+
+
 def _readonly(name: str, value: Any, ndim: int) -> np.ndarray:
     try:
         arr = np.asarray(value, dtype=float)
@@ -335,6 +373,10 @@ class SimulationResult:
     steps : AcceptedSteps, optional
         The state at every accepted step (``simulate(..., record_steps=True)``): the dense
         record from which statistics that must not depend on the output grid are taken.
+    step_search_states : dict, optional
+        With ``steps`` on a compiled integrator: the search state of every stateful force kind
+        after every accepted step, by the kind's element names
+        (:func:`search_states_at_steps`).
 
     Notes
     -----
@@ -360,6 +402,7 @@ class SimulationResult:
     reactions: dict[str, np.ndarray] = field(default_factory=dict)
     reaction_names: dict[str, list[str]] = field(default_factory=dict)
     steps: AcceptedSteps | None = None
+    step_search_states: dict[tuple[str, ...], np.ndarray] | None = None
 
     # -- validation ---------------------------------------------------------------
     def __post_init__(self) -> None:  # noqa: C901 - one check per field, in order
@@ -588,6 +631,26 @@ class SimulationResult:
         df = self._frame(np.array(self.reactions[joint_name]), self.reaction_names[joint_name])
         df.attrs["joint"] = joint_name
         return df
+
+    def summary_row(self, label: str, checks: dict[str, Any] | None = None) -> dict[str, Any]:
+        """One row of an integrator comparison table, as a dict: ``integrator`` (``label``), status,
+        wall time, steps, max position and velocity violation, max energy drift (conservative
+        systems), the run's own ``checks`` (``{"period error [s]": ...}``) and last ``remarks``
+        (the warnings of a finished run, or why it failed; "none" if there are none).  Collect
+        the rows into a DataFrame."""
+        row: dict[str, Any] = {
+            "integrator": label,
+            "status": self.status,
+            "wall time [s]": self.meta.get("wall_time_s", np.nan),
+            "steps [-]": self.counters.get("n_steps", 0),
+            "max |Φ| [m]": float(np.max(self.position_violation)),
+            "max |Φ_q v − ν| [m/s]": float(np.max(self.velocity_violation)),
+        }
+        if self.energy is not None:
+            row["max |E − E0| [J]"] = float(np.max(np.abs(self.energy - self.energy[0])))
+        row.update(checks or {})
+        row["remarks"] = ("; ".join(self.warnings) or "none") if self.success else self.message
+        return row
 
     def summary(self) -> pd.DataFrame:
         """Return a one-row DataFrame: status, metadata, counters, final and max violations, energy drift.

@@ -40,7 +40,7 @@ import pandas as pd
 from .errors import InputError
 
 __all__ = ["GridResolutionWarning", "level_intervals", "peak", "grid_resolution", "level_summary",
-           "hidden_extremes", "dense_level_intervals"]
+           "hidden_extremes", "dense_level_intervals", "zero_crossings"]
 
 
 class GridResolutionWarning(UserWarning):
@@ -341,3 +341,13 @@ def dense_level_intervals(t, x, dxdt, level, side, evaluate: Callable[[float], t
         iv["peak"] = pd.Series(dtype=float)
         iv["between samples"] = pd.Series(dtype=bool)
     return iv
+
+
+def zero_crossings(x, y) -> np.ndarray:
+    """Where ``y`` changes sign along ``x``: the crossings located by linear interpolation between
+    the samples on either side, :math:`x_i - y_i (x_{i+1} - x_i)/(y_{i+1} - y_i)`.  A sample that is
+    exactly zero starts no crossing of its own (its neighbours' sign change counts once)."""
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    i = np.nonzero((np.sign(y[:-1]) != np.sign(y[1:])) & (y[:-1] != 0))[0]
+    return x[i] - y[i] * (x[i + 1] - x[i]) / (y[i + 1] - y[i])

@@ -31,7 +31,7 @@ import concurrent.futures
 from collections.abc import Callable, Iterable
 from typing import TypeVar
 
-__all__ = ["run_sweep"]
+__all__ = ["executor_workers", "run_sweep"]
 
 C = TypeVar("C")
 R = TypeVar("R")
@@ -109,3 +109,26 @@ def run_sweep(
             future.cancel()
         raise
     return results
+
+
+def executor_workers(executor: concurrent.futures.Executor | None) -> int | None:
+    """The number of workers behind ``executor``, as a sweep's report states it.
+
+    Parameters
+    ----------
+    executor : concurrent.futures.Executor or None
+        None (a serial sweep in this process), a standard-library process or thread pool, or
+        any other executor (a ``dask.distributed`` client's).
+
+    Returns
+    -------
+    int or None
+        1 for None; the pool's ``max_workers`` for a :class:`concurrent.futures.ProcessPoolExecutor`
+        or :class:`~concurrent.futures.ThreadPoolExecutor`; None when the executor does not say
+        (a cluster may grow and shrink while it runs).
+    """
+    if executor is None:
+        return 1
+    if isinstance(executor, (concurrent.futures.ProcessPoolExecutor, concurrent.futures.ThreadPoolExecutor)):
+        return int(executor._max_workers)  # the standard library keeps it only here
+    return None

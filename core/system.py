@@ -126,7 +126,7 @@ class ConstrainedSystem(ABC):
         return q
 
     def invariant_violation(self, q: Array) -> float:
-        """Largest violation of coordinate invariants not held by multipliers (e.g. |p|² − 1)."""
+        """Largest violation of coordinate invariants not held by multipliers (e.g. ``|p|²`` − 1)."""
         return 0.0
 
     # --- optional Jacobians of Q (finite differences by default) ----------------------------

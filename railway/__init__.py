@@ -1,53 +1,72 @@
 """Railway wheel-rail contact mechanics and railway vehicles on the core.
 
-Geometry half of the railway domain (the Hertz theory and the Lankarani-Nikravesh law are
-core's, :mod:`core.contact_laws`; the creep laws live in :mod:`railway.creep`):
+Two halves, one sub-package each, over what both use (issue 22):
 
-* :mod:`railway.profiles` -- S1002 wheel (analytic definition), UIC60 rail (arcs) and measured
-  profiles, as smooth curves with first and second derivatives;
-* :mod:`railway.track` -- track centreline (straight, circular curve, clothoid), cant,
-  irregularities, moving track frame, rail mounting (inclination, gauge at 14 mm);
-* :mod:`railway.surfaces` -- wheel surface of revolution and swept rail surface;
-* :mod:`railway.contact_search` -- vectorised four-condition contact search (Pombo, Ambrosio &
-  Silva 2007) with tread and flange candidates, global re-seeding and warm starts;
-* :mod:`railway.contact_geometry` -- rigid contact-geometry table and equivalent conicity
-  (EN 15302), flange lead with yaw;
-* :mod:`railway.forces` -- Hertz + Lankarani-Nikravesh normal and creep forces of all contacts
-  of a search in one (compiled) call, with the wheel-rail helpers (curvatures by wheel and rail
-  radii, the steady-rolling engagement-velocity floor);
-* :mod:`railway.two_point` -- two-point contact: conical profile, rigid onset, brute-force check;
-* :mod:`railway.quasi_static` -- wheelset position under vertical wheel loads (elastic Hertz),
-  and rolling with the creep forces in the balance (Manchester contact benchmark);
-* :mod:`railway.assessment` -- Nadal's limit, Hertz pressure, wear number, Y/Q;
-* :mod:`railway.wheel_rail` -- the wheel-rail contact as a force element of the core (all wheels
-  of a model in one call; :mod:`railway.wheel_rail_compiled` its compiled kernels);
-* :mod:`railway.vehicle` -- vehicles from a TOML file (car body, bogies, wheelsets, suspensions),
-  static preload; :mod:`railway.traction` -- speed control along the track;
-* :mod:`railway.curving_start` -- the quasi-static curving state: a vehicle's start in a curve or
-  a transition at its speed (``Vehicle.equilibrium``, ``Vehicle.initial_state``);
-* :mod:`railway.hunting` -- Klingel's wavelength and the critical speed of a suspended wheelset;
-* :mod:`railway.wheelset_models` -- free and suspended single-wheelset models;
-* :mod:`railway.scenes`, :mod:`railway.vehicle_scenes` -- scenes for ``mbsuite run``.
+* :mod:`railway.contact` -- contact mechanics of a wheel on its rail: profiles
+  (:mod:`~railway.contact.profiles`), wheel and rail surfaces (:mod:`~railway.contact.surfaces`),
+  the four-condition contact search (:mod:`railway.contact.search`: seed scan, Newton solve,
+  robust refinement, zone bookkeeping, compiled kernels), contact-geometry tables and
+  conicity (:mod:`~railway.contact.geometry`), two-point contact
+  (:mod:`~railway.contact.two_point`), creep laws (:mod:`~railway.contact.creep`), creepages
+  (:mod:`~railway.contact.creepage`), creep curves (:mod:`~railway.contact.creep_curve`), Hertz and
+  creep forces of a search's contacts (:mod:`~railway.contact.forces`), the quasi-static wheelset
+  (:mod:`~railway.contact.quasi_static`) and the Manchester contact benchmark
+  (:mod:`~railway.contact.manchester_contact`); the Hertz theory and the Lankarani-Nikravesh law
+  are core's (:mod:`core.contact_laws`);
+* :mod:`railway.vehicles` -- vehicle dynamics: vehicles from a TOML file
+  (:mod:`~railway.vehicles.vehicle`, :mod:`~railway.vehicles.vehicle_file`), the wheel-rail contact
+  as a force element of the core (:mod:`~railway.vehicles.wheel_rail`, its compiled kernels
+  :mod:`~railway.vehicles.wheel_rail_compiled` and the rules both share,
+  :mod:`~railway.vehicles.wheel_rail_rules`), speed control (:mod:`~railway.vehicles.traction`),
+  the quasi-static curving start (:mod:`~railway.vehicles.curving_start`), hunting
+  (:mod:`~railway.vehicles.hunting`) and the single-wheelset models
+  (:mod:`~railway.vehicles.wheelset_models`);
+* shared by both halves, so beside them: :mod:`railway.track` -- track centreline (straight,
+  circular curve, clothoid), cant, irregularities, moving track frame (the vehicles run on it) and
+  rail mounting (inclination, gauge at 14 mm: the contact searches on it);
+  :mod:`railway.assessment` -- Nadal's limit, Hertz pressure, wear number, Y/Q per contact and
+  wheel (the quasi-static contact and the force element report them) and the track-test
+  statistics of wheel-force histories; :mod:`railway.ranges` -- plausible ranges of every input;
+* :mod:`railway.cli` -- ``mbsuite railway ...`` sub-commands;
+* :mod:`railway.scenes`, :mod:`railway.vehicle_scenes` -- scenes for ``mbsuite run``;
+* :mod:`railway.moved_modules` -- the module paths before issue 22 (``railway.profiles``,
+  ``railway.contact_search``, ``railway.wheel_rail``, ...) still import, as the same module,
+  with a DeprecationWarning naming the new place.
+
+Import direction: ``contact`` never imports ``vehicles``; ``track`` needs only
+:mod:`railway.contact.profiles` (the rail profile it mounts).  A test (tests/railway/
+test_architecture.py) keeps the package's import graph free of circles.
 
 SI units throughout (m, rad); mm only in profile files and CLI output.
 """
 
-from .contact_geometry import (
+from .moved_modules import install as _install_moved_modules
+from .moved_modules import old_module_attribute as __getattr__
+
+_install_moved_modules()
+
+from .contact import (
+    ContactForces,
+    ContactResult,
+    ContactSearch,
+    RailProfile,
+    RailSurface,
+    WheelProfile,
+    WheelSurface,
     conicity_table,
     contact_geometry_table,
     contact_transitions,
     equivalent_conicity,
     flange_contact_onset,
+    quasi_static_contact,
+    quasi_static_summary,
+    read_profile_file,
     rigid_contact,
+    s1002_exact,
+    uic60_exact,
+    wheelset_pose,
 )
-from .contact_search import ContactResult, ContactSearch, wheelset_pose
-from .forces import ContactForces
-from .profiles import RailProfile, WheelProfile, read_profile_file, s1002_exact, uic60_exact
-from .quasi_static import quasi_static_contact, quasi_static_summary
 from .ranges import IrregularityStepWarning, RailwayInputWarning, SuspensionGeometryWarning
-from .vehicle import Vehicle, VehicleDefinition, build_vehicle
-from .wheel_rail import WheelRailContact, contact_history
-from .surfaces import RailSurface, WheelSurface
 from .track import (
     Curve,
     Irregularities,
@@ -58,6 +77,7 @@ from .track import (
     Transition,
     parse_inclination,
 )
+from .vehicles import Vehicle, VehicleDefinition, WheelRailContact, build_vehicle, contact_history
 
 __all__ = [
     "ContactForces",

@@ -29,7 +29,7 @@ The work rate of the creep forces on the rigid creepages is -V (Fx xi + Fy eta +
 the forces opposing the creepages; in full sliding at large creepage it is the frictional
 dissipation of the patch (the elastic part of the local slip adds little): CONTACT's frictional
 power for the Manchester cases equals it to 0.5 % where y >= 6.5 mm and to 3.5 % at the smallest
-full-slip creepages (tested).  T_gamma is that work per metre *without the spin term* |Mz phi|:
+full-slip creepages (tested).  T_gamma is that work per metre *without the spin term* ``|Mz phi|``:
 T-gamma damage functions and the usual engineering definition (the project notes, section 5)
 use the two creep forces only; pass ``Mz`` and ``phi`` to add it.
 
@@ -41,7 +41,7 @@ downwards)::
 
 so that Y/Q > 0 on a flange-climbing wheel (the flange pushes its rail outwards).  From the
 contact-frame forces (N along the rail normal n into the wheel, Fx along t, Fy along
-l = n x t, the frame of :class:`railway.forces.ContactForces`), the force on the wheel is
+l = n x t, the frame of :class:`railway.contact.forces.ContactForces`), the force on the wheel is
 F = N n + Fx t + Fy l; summed over the contacts c of a wheel on side sigma (+1 left, -1 right)
 with the track's lateral axis e_lat (to the left) and up axis e_up::
 
@@ -75,7 +75,7 @@ parameters are the defaults of the functions, not limits.
 Events and peaks (:func:`wheel_event_statistics`) are taken from the accepted steps of the run
 (``simulate(..., record_steps=True)``, ``contact_history(..., at="steps")``), not from the output
 grid: wheel lift is the set where Q = 0, its boundaries located by bisection on Q > 0 inside the
-step (event location); the time with Y/Q above a limit and the peaks of Q, |Y|, Y/Q and the
+step (event location); the time with Y/Q above a limit and the peaks of Q, ``|Y|``, Y/Q and the
 flange force are taken over every accepted step (:mod:`core.signals`).  So they do not change
 with the output step, and a lift shorter than it is found; the table says how many of the
 events the output grid of the run would not show.
@@ -142,7 +142,7 @@ def nadal_limit(contact_angle, mu):
     Parameters
     ----------
     contact_angle : float or array_like
-        Flange contact angle gamma (rad), |gamma| < pi/2 (e.g. 70 deg = 1.22 rad for a new
+        Flange contact angle gamma (rad), ``|gamma|`` < pi/2 (e.g. 70 deg = 1.22 rad for a new
         S1002 flank).
     mu : float or array_like
         Friction coefficient at the flange contact, >= 0.
@@ -156,7 +156,7 @@ def nadal_limit(contact_angle, mu):
     Raises
     ------
     core.errors.InputError
-        A non-finite value, |gamma| >= pi/2 or mu < 0 (names the value).
+        A non-finite value, ``|gamma|`` >= pi/2 or mu < 0 (names the value).
 
     References
     ----------
@@ -217,7 +217,7 @@ def max_pressure(N, a, b):
 
 
 def wear_number(Fx, Fy, xi, eta, Mz=None, phi=None):
-    """Wear number T_gamma = |Fx xi| + |Fy eta|, Eq. (A3) [N = J/m].
+    """Wear number T_gamma = ``|Fx xi|`` + ``|Fy eta|``, Eq. (A3) [N = J/m].
 
     Parameters
     ----------
@@ -226,7 +226,7 @@ def wear_number(Fx, Fy, xi, eta, Mz=None, phi=None):
     xi, eta : float or array_like
         Longitudinal and lateral creepages [-].
     Mz, phi : float or array_like, optional
-        Spin moment (N m) and spin creepage (1/m).  Given together, |Mz phi| is added, so the
+        Spin moment (N m) and spin creepage (1/m).  Given together, ``|Mz phi|`` is added, so the
         result is the whole frictional dissipation per metre rolled (module docstring); left
         out by default, as in the usual T-gamma definition.
 
@@ -289,12 +289,12 @@ def wheel_forces_track(N, Fx, Fy, normal, rolling_direction, side, lateral=(0.0,
     ----------
     N, Fx, Fy : (n_wheels, n_contacts) array_like
         Normal force and the creep forces along t and l = n x t of every contact candidate
-        (the frame of :class:`railway.forces.ContactForces`), zero for unloaded candidates.
+        (the frame of :class:`railway.contact.forces.ContactForces`), zero for unloaded candidates.
     normal : (n_wheels, n_contacts, 3) array_like
         Rail normal into the wheel (global); ignored (may be NaN) where N = Fx = Fy = 0.
     rolling_direction : (n_wheels, 3) or (n_wheels, n_contacts, 3) array_like
         Forward axis of the wheelset (projected onto each tangent plane here, as in
-        :class:`railway.forces.ContactForces`).
+        :class:`railway.contact.forces.ContactForces`).
     side : (n_wheels,) array_like
         +1 for a left wheel, -1 for a right wheel.
     lateral, up : (3,) or (n_wheels, 3) array_like
@@ -438,14 +438,14 @@ def sliding_mean(s, x, window=WINDOW_M, step=SAMPLING_M):
 def wheel_force_statistics(H, cutoff=CUTOFF_HZ, window=WINDOW_M, step=SAMPLING_M, percentiles=PERCENTILES):
     """Track-test statistics of simulated wheel forces (module docstring, A6-A7).
 
-    ``H``: the long table of :func:`railway.wheel_rail.contact_history` at a uniform output rate
+    ``H``: the long table of :func:`railway.vehicles.wheel_rail.contact_history` at a uniform output rate
     that resolves the wheelset's bounce (at least a few hundred Hz; 1 kHz in the scenes), with
     columns ``t [s]``, ``wheel``, ``wheelset``, ``s [m]``, ``Q [N]``, ``Y [N]``, ``sum Y [N]``.
 
     Per wheel: Q low-pass filtered at ``cutoff`` and its percentiles (``Q high [N]``, ``Q low
     [N]``), the unfiltered extremes of the samples (``Q max, unfiltered [N]``, ``Q min, unfiltered
     [N]``: extremes of this output grid, which change with its step; the peaks of the run are
-    those of :func:`wheel_event_statistics`, from every accepted step), |Y|
+    those of :func:`wheel_event_statistics`, from every accepted step), ``|Y|``
     filtered, its upper percentile (``|Y| high [N]``); Y/Q of the filtered forces as a sliding
     mean over ``window`` m, its upper percentile (``(Y/Q) 2 m high [-]``); per wheelset the same
     of the filtered sum Y, the largest magnitude of its two percentiles (``(sum Y) 2 m high
@@ -491,7 +491,7 @@ def wheel_event_statistics(H, output_times=None, yq_limit=None, warn=True):
     Parameters
     ----------
     H : DataFrame
-        :func:`railway.wheel_rail.contact_history` with ``at="steps"`` (every accepted step of a
+        :func:`railway.vehicles.wheel_rail.contact_history` with ``at="steps"`` (every accepted step of a
         run made with ``record_steps=True``); its ``attrs["lift crossings"]`` give the located
         lift-off and touch-down times (else they are interpolated, to one step).  A table on
         the output grid is refused: its statistics would change with the output step.

@@ -2,8 +2,8 @@
 
 The ranges are data (``data/railway/plausible_ranges.csv``, read once per process by
 :func:`ranges`); :mod:`core.inputs` documents the columns and how a value outside its range is
-refused with the likely unit slip named.  The vehicle file (:mod:`railway.vehicle_file`), the
-track (:mod:`railway.track`), the profile readers and :func:`railway.vehicle.build_vehicle` check
+refused with the likely unit slip named.  The vehicle file (:mod:`railway.vehicles.vehicle_file`), the
+track (:mod:`railway.track`), the profile readers and :func:`railway.vehicles.vehicle.build_vehicle` check
 their inputs against this one table.
 """
 

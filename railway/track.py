@@ -75,7 +75,6 @@ from core.curves import (
 )
 from core.errors import DataRangeError, InputError
 
-from .profiles import RailProfile
 
 __all__ = [
     "Curve",
@@ -557,7 +556,7 @@ class Track(FramedCurve):
         """
         return self.frame_table.evaluate_raw(s)
 
-    _frame_fast = evaluate_raw  # name used by railway.contact_search
+    _frame_fast = evaluate_raw  # name used by railway.contact.search
 
     def _assemble(self, o, third):
         """Frame quantities from raw (value, d1, d2) rows of the base table."""
@@ -654,6 +653,9 @@ class RailMounting:
     """
 
     def __init__(self, profile=None, gauge=1.435, inclination=1 / 40, gauge_depth=0.014, accept=()):
+        # the rail profile is contact mechanics: imported here, when a rail is mounted, so that this
+        # module, which both halves import, needs nothing of railway.contact at import time
+        from .contact.profiles import RailProfile, rail_crown_problem
         from .ranges import ranges
 
         self.profile = profile if profile is not None else RailProfile.uic60()
@@ -672,8 +674,6 @@ class RailMounting:
         al = np.arctan(self.inclination)
         self.ca, self.sa = float(np.cos(al)), float(np.sin(al))
         p = self.profile
-        from .profiles import rail_crown_problem
-
         problem = rail_crown_problem(p)
         if problem:
             raise InputError(f"rail mounting: profile {p.name}: rail head has no crown: {problem}")

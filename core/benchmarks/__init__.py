@@ -9,7 +9,7 @@ module              holds
 ``testset``         Andrews' squeezer and the car axis of the IVP test set (generalized coordinates)
 ``harness``         runs integrators over tolerance / step-size grids into one tidy table
 ``report``          fastest run per error target, work-precision figures, CSV/Markdown/PNG writers
-``scenes``          the ``work-precision`` scene of ``make run``
+``scenes``          the ``work-precision`` scene of ``make run`` (examples/core/work_precision.py)
 ==================  ===========================================================================
 
 The command ``mbsuite bench`` lives in :mod:`core.cli`.  ``import core`` does not import this
@@ -49,6 +49,7 @@ from .report import (
     fastest_to_tolerance,
     report_table,
     work_precision_figure,
+    work_precision_notes,
     write_work_precision,
 )
 from .scenes import work_precision_scenes
@@ -81,6 +82,7 @@ __all__ = [
     "stiff_chain_rhs",
     "stiff_chain_tip_reference",
     "work_precision_figure",
+    "work_precision_notes",
     "work_precision_scenes",
     "write_work_precision",
 ]

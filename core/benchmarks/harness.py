@@ -345,20 +345,26 @@ def _reference_of(problem: WorkPrecisionProblem) -> Any:
 
 def run_problem_set(problems: Sequence[str], grid: str, methods=None, repeats: int = 3, jobs: int = 1,
                     progress: bool = False, report: Callable[[str], None] | None = None,
-                    max_repeat_time: float = 2.0) -> pd.DataFrame:
+                    max_repeat_time: float = 2.0, executor: Executor | None = None) -> pd.DataFrame:
     """Run several problems as one sweep (so a process pool stays busy across problems).
 
     Used by ``mbsuite bench`` and the ``work-precision`` scene: ``grid`` names the grid of every
-    problem, ``jobs > 1`` runs the references and the cases on a process pool of that size, and
-    ``report(text)`` receives progress lines.  Returns the concatenated tables of
+    problem, and ``report(text)`` receives progress lines.  The references and the cases run on
+    ``executor`` when one is given (:func:`core.sweep.run_sweep`; it is not shut down, and
+    ``jobs`` must then stay 1), else on a process pool of ``jobs`` processes that lives for the
+    call (``jobs = 1``: serially in this process).  Returns the concatenated tables of
     :func:`run_work_precision`.
     """
     from concurrent.futures import ProcessPoolExecutor
 
     from ..sweep import run_sweep
 
+    if executor is not None and jobs != 1:
+        raise ValueError(f"run_problem_set: give an executor or jobs={jobs}, not both")
+    own_pool = ProcessPoolExecutor(max_workers=jobs) if executor is None and jobs > 1 else None
+    executor = executor if executor is not None else own_pool
+    where = f"{jobs} process(es)" if executor is None or own_pool is not None else "the given executor"
     probs = [_resolve_problem(name) for name in problems]
-    executor = ProcessPoolExecutor(max_workers=jobs) if jobs > 1 else None
     try:
         if report is not None:
             report(f"computing the references of {len(probs)} problem(s)")
@@ -373,11 +379,11 @@ def run_problem_set(problems: Sequence[str], grid: str, methods=None, repeats: i
             plan.append((prob, g, len(all_cases), len(cases)))
             all_cases += cases
         if report is not None:
-            report(f"{len(all_cases)} runs of {len(plan)} problem(s) on {jobs} process(es)")
+            report(f"{len(all_cases)} runs of {len(plan)} problem(s) on {where}")
         rows = run_sweep(_run_case, all_cases, executor=executor, progress=progress)
     finally:
-        if executor is not None:
-            executor.shutdown()
+        if own_pool is not None:
+            own_pool.shutdown()
     frames = []
     for prob, g, start, n in plan:
         df = _frame(prob, g, rows[start:start + n])

@@ -34,7 +34,7 @@ from .harness import COLUMNS, COUNTERS, SETTING_RTOL, SETTING_STEP
 from .problems import PROBLEMS
 
 __all__ = ["REPORT_COLUMNS", "fastest_to_tolerance", "report_table", "work_precision_figure",
-           "write_work_precision"]
+           "work_precision_notes", "write_work_precision"]
 
 #: Columns of the harness table renamed for the written report (units in brackets).
 _RENAME = {"rtol": "rtol [-]", "atol": "atol [units of q, v]", "n repeats": "n repeats [-]",
@@ -260,3 +260,34 @@ def write_work_precision(df: pd.DataFrame, out_dir: str | Path, prefix: str = "w
     summary = report_table(fastest_to_tolerance(df))
     written["summary"] = write_table(summary, out, f"{prefix}_summary", floatfmt=".3g")
     return written
+
+
+def work_precision_notes(problems: Sequence[str], grid: str, workers: int | None) -> str:
+    """The Markdown notes of a work-precision report: how it was run and each problem's error measure.
+
+    Parameters
+    ----------
+    problems : sequence of str
+        Names of registered problems (:data:`~core.benchmarks.problems.PROBLEMS`).
+    grid : str
+        The grid the problems ran on (``"quick"``, ``"standard"``, ``"full"``).
+    workers : int or None
+        Worker processes the solves ran on (:func:`core.sweep.executor_workers`; None: a
+        distributed executor of varying size).
+
+    Returns
+    -------
+    str
+        A paragraph on the grid, the workers, the wall-time measure and the tolerances, then a
+        table ``problem | error measure | reference``.
+    """
+    who = f"{workers} worker process(es)" if workers is not None else "the workers of a distributed executor"
+    lines = [(f"Grid `{grid}`; {who} (solves run concurrently when > 1, which may "
+              "inflate wall times slightly). Wall time = median over repeats of the time inside the "
+              "integrator steps. Fixed-step methods: Newton tolerance rtol = atol = 1e-10; "
+              "error-controlled methods: atol = rtol."),
+             "", "| problem | error measure | reference |", "|---|---|---|"]
+    for name in problems:
+        p = PROBLEMS[name]
+        lines.append(f"| {name} | {p.error_measure} | {p.reference_note} |")
+    return "\n".join(lines)

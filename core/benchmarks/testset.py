@@ -112,10 +112,10 @@ class AndrewsSqueezer(ConstrainedSystem):
 
     References
     ----------
-    E. Hairer, G. Wanner, *Solving ODEs II*, Springer, 1996, Sec. VII.7, pp. 530–536.
-    F. Mazzia, C. Magherini, *Test Set for IVP Solvers*, release 2.4, Univ. of Bari, 2008,
-    problem "Andrews' squeezing mechanism".
-    W. Schiehlen (ed.), *Multibody Systems Handbook*, Springer, 1990.
+    - E. Hairer, G. Wanner, *Solving ODEs II*, Springer, 1996, Sec. VII.7, pp. 530–536.
+    - F. Mazzia, C. Magherini, *Test Set for IVP Solvers*, release 2.4, Univ. of Bari, 2008,
+      problem "Andrews' squeezing mechanism".
+    - W. Schiehlen (ed.), *Multibody Systems Handbook*, Springer, 1990.
     """
 
     name = "andrews_squeezer"

@@ -253,6 +253,19 @@ class CompiledModel:
             out[a:b] = blk.ravel()
         return out
 
+    def state_blocks(self, states: np.ndarray) -> dict[tuple[str, ...], np.ndarray]:
+        """The search state of every stateful force kind in the flat ``states`` (one row, or rows
+        of a run's steps), by the kind's element names: copies of shape ``(..., n_elements,
+        width)``, the layout of the kind's own ``state`` (its accept kernel's view)."""
+        states = np.asarray(states)
+        out = {}
+        for k, rec in enumerate(self.force_kinds):
+            a, b = int(self._st_off[k]), int(self._st_off[k + 1])
+            if b > a:
+                shape = states.shape[:-1] + (int(self._st_n[k]), int(self._st_w[k]))
+                out[tuple(rec.names)] = np.array(states[..., a:b]).reshape(shape)
+        return out
+
     def failure_description(self, kind: int, states: np.ndarray) -> str:
         """The kind's own description of a failure its kernels reported ('' if none)."""
         if not (0 <= kind < len(self.force_kinds)):

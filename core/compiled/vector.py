@@ -3,26 +3,25 @@ r"""Scalar 3-vector kinematics for writing kernels (inlined into the caller; no 
 Body states are in three-dimensional form (see :mod:`core.compiled.protocol`); for a body ``b``
 and a body-fixed vector ``s̄`` (Nikravesh 1988, Eqs. 6.151–6.156):
 
-============================  ================================================================
-function                      returns
-============================  ================================================================
-``Av(A, b, x)``               ``A_b x``
-``ATv(A, b, x)``              ``A_bᵀ x``
-``cross(a, b)``               ``a × b``
-``vel(A, w, b, s̄)``           ``C(s̄) ω_b = A_b (ω̄_b × s̄)``: velocity of a body-fixed vector
-``aq(A, w, b, s̄)``            ``a^q(s̄) = A_b (ω̄ × (ω̄ × s̄))``: its velocity-product acceleration
-``uC(A, b, s̄, u)``            ``uᵀ C(s̄) = (s̄ × A_bᵀu)ᵀ``: a row of the rotational Jacobian
-``rel_point(…)``              ``d = r_Q − r_P`` (P = s̄_p on body i, Q = s̄_q on body j)
-``rel_vel(…)``                ``ḋ = ṙ_Q − ṙ_P``
-``put_row(G, row, sl, dim,    writes a Jacobian row block ``(t; c)`` in the model's velocity
-t, c)``                       layout: planar ``(t₀, t₁, c₂)``, spatial ``(t, c)``
-``add_point_force(Q, A, b,    ``Q_b += sign · [F; C(s̄)ᵀ F]`` (the ground is skipped)
-nb, dim, s̄, F, sign)``
-``add_body_moment(Q, b, nb,   ``Q_b`` rotational part ``+= M̄`` (body-frame moment; planar: z)
-dim, M̄)``
-``add_block(Q, b, nb, dim,    ``Q_b += s · (t; c)``: a generalized force given in the 3-D block
-t, c, s)``                    form (translation, body-frame rotation) of a gradient row
-============================  ================================================================
+================================================= ================================================================
+function                                          returns
+================================================= ================================================================
+``Av(A, b, x)``                                   ``A_b x``
+``ATv(A, b, x)``                                  ``A_bᵀ x``
+``cross(a, b)``                                   ``a × b``
+``vel(A, w, b, s̄)``                               ``C(s̄) ω_b = A_b (ω̄_b × s̄)``: velocity of a body-fixed vector
+``aq(A, w, b, s̄)``                                ``a^q(s̄) = A_b (ω̄ × (ω̄ × s̄))``: its velocity-product
+                                                  acceleration
+``uC(A, b, s̄, u)``                                ``uᵀ C(s̄) = (s̄ × A_bᵀu)ᵀ``: a row of the rotational Jacobian
+``rel_point(…)``                                  ``d = r_Q − r_P`` (P = s̄_p on body i, Q = s̄_q on body j)
+``rel_vel(…)``                                    ``ḋ = ṙ_Q − ṙ_P``
+``put_row(G, row, sl, dim, t, c)``                writes a Jacobian row block ``(t; c)`` in the model's velocity
+                                                  layout: planar ``(t₀, t₁, c₂)``, spatial ``(t, c)``
+``add_point_force(Q, A, b, nb, dim, s̄, F, sign)`` ``Q_b += sign · [F; C(s̄)ᵀ F]`` (the ground is skipped)
+``add_body_moment(Q, b, nb, dim, M̄)``             ``Q_b`` rotational part ``+= M̄`` (body-frame moment; planar: z)
+``add_block(Q, b, nb, dim, t, c, s)``             ``Q_b += s · (t; c)``: a generalized force given in the 3-D
+                                                  block form (translation, body-frame rotation) of a gradient row
+================================================= ================================================================
 
 Planar bodies rotate about z, so ``C(s̄) ω = A(ω × s̄)`` and ``a^q = A(ω × (ω × s̄))`` reproduce
 the planar ``A R s̄ θ̇`` and ``−A s̄ θ̇²`` exactly: one kernel serves planar and spatial models.

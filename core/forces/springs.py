@@ -655,7 +655,7 @@ class BumpStop(ForceElement):
     :func:`core.forces.coordinates.coordinate_jacobian`) with ``∂f/∂u = g'(|u|)`` and
     ``∂f/∂u̇ = c`` while engaged.  ``g`` is continuous but its slope jumps at the table rows: at a
     row ``|u| = d_k`` (and at the clearance ``|u| = d_0``) the slope of the outer segment
-    ``S_k`` (the right derivative in |u|) is used, inside the clearance the slope is 0; these
+    ``S_k`` (the right derivative in ``|u|``) is used, inside the clearance the slope is 0; these
     one-sided derivatives are what the Newton iterations of the implicit integrators see.
 
     Parameters

@@ -109,7 +109,7 @@ class HalfExplicitRK(Integrator):
 
     fixed_step = True
     tableau: dict = HEM4_TABLEAU
-    #: |h λ| at which the underlying explicit RK leaves its stability region on the imaginary axis
+    #: ``|h λ|`` at which the underlying explicit RK leaves its stability region on the imaginary axis
     #: (undamped oscillation, the case of stiff springs), from the stability function
     #: R(z) = 1 + z bᵀ(I − zA)⁻¹𝟙 of the tableau: 3.27 for HEM4 (5.36 on the negative real axis).
     stability_limit: float = 3.27

@@ -418,7 +418,7 @@ def test_flat_and_inward_banked_tracks_pass_silently():
 def test_designed_bank_on_a_circle_gives_zero_lateral_load():
     """Level circle R = 30 m at 20 m/s: design_bank gives tan(beta) = v²/(g R) and the rider at the track
     point feels no lateral load (rtol 1e-10 of the run; tolerance 1e3 rtol (1 + q))."""
-    from coaster.analytic_scene import _run
+    from coaster.analytic_scene import run_body_on_track
     from coaster.rider import rider_loads
 
     R, v = 30.0, 20.0
@@ -427,7 +427,7 @@ def test_designed_bank_on_a_circle_gives_zero_lateral_load():
     b = design_bank(arc, v, step=1.0)
     assert np.allclose(b(np.linspace(1, 180, 7))[0], -math.atan(q), rtol=0, atol=1e-12)
     fr = RotationMinimisingFrame(arc, bank=b, bank_reference="vertical", max_step=0.25, tol=1e-12)
-    model, _, res, _ = _run("designed bank", fr, 0.0, v, 2.0, 500.0, (100.0, 150.0, 200.0))
+    model, _, res, _ = run_body_on_track("designed bank", fr, 0.0, v, 2.0, 500.0, (100.0, 150.0, 200.0))
     loads = rider_loads(model, res, "car", jerk=False)
     tol = 1e3 * 1e-10 * (1 + q)
     assert np.abs(loads["n_y [g]"]).max() < tol

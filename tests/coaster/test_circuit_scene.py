@@ -18,7 +18,7 @@ def out(tmp_path_factory):
 
 
 def test_registered():
-    assert [s.name for s in coaster_scenes()] == ["coaster-analytic", "coaster-circuit"]
+    assert [s.name for s in coaster_scenes()] == ["coaster-analytic", "coaster-circuit", "coaster-from-control-points"]
 
 
 def test_circuit_scene_outputs(out):

@@ -109,13 +109,54 @@ def test_run_usage_errors(registry, capsys, tmp_path):
 def test_run_one_scene_writes_tables_figures_readme(registry, tmp_path, capsys):
     assert cli.main(["run", "ok-scene", "-o", str(tmp_path), "--fast"]) == 0
     folder = tmp_path / "ok-scene"
-    assert sorted(p.name for p in folder.iterdir()) == ["README.md", "parabola.csv", "parabola.md", "parabola.png"]
+    assert sorted(p.name for p in folder.iterdir()) == ["README.md", "parabola.csv", "parabola.csv-metadata.json",
+                                                        "parabola.md", "parabola.png", "run.json"]
     df = pd.read_csv(folder / "parabola.csv")
     assert len(df) == 5  # fast mode reached the scene
     readme = (folder / "README.md").read_text()
     assert "# A parabola" in readme and "parabola.csv" in readme and "parabola.png" in readme
     assert "fast=True, sum=10" in readme
     assert "ok-scene" in (tmp_path / "README.md").read_text()
+
+
+def test_every_output_says_how_it_was_run(registry, tmp_path, capsys):
+    """run.json, the scene README's last section, the table's CSVW metadata and the line under the
+    Markdown table all name the mode, wall time, processor, versions, date and git revision; the
+    index lists every scene folder in OUT, also those of earlier commands."""
+    import json
+
+    from core.provenance import cpu_model, package_versions
+
+    assert cli.main(["run", "ok-scene", "-o", str(tmp_path), "--fast"]) == 0
+    folder = tmp_path / "ok-scene"
+    run = json.loads((folder / "run.json").read_text())
+    assert run["mode"] == "fast" and run["status"] == "ok" and run["scene"] == "ok-scene"
+    assert run["processor"] == cpu_model() and run["versions"]["numpy"] == package_versions()["numpy"]
+    assert run["wall_time_s"] > 0 and run["started"].endswith("+00:00") and run["git_revision"]
+    readme = (folder / "README.md").read_text()
+    section = readme[readme.index("## How this scene was run"):]
+    for text in ("| mode | fast |", "| wall time |", cpu_model(), f"numpy {package_versions()['numpy']}",
+                 "| git revision |", "| started (UTC) |"):
+        assert text in section, text
+    meta = json.loads((folder / "parabola.csv-metadata.json").read_text())
+    assert meta["url"] == "parabola.csv" and meta["mbsuite:run"] == run
+    md = (folder / "parabola.md").read_text()
+    assert "mode fast" in md.splitlines()[-1] and run["git_revision"] in md.splitlines()[-1]
+    # a second command into the same folder: the index keeps the first scene, with its mode
+    assert cli.main(["run", "bad_scene", "-o", str(tmp_path)]) == 1
+    index = (tmp_path / "README.md").read_text()
+    assert "| [ok-scene](ok-scene/README.md) | A parabola | ok | fast |" in index
+    assert "| [bad_scene](bad_scene/error.txt) | Always fails | failed (see bad_scene/error.txt) | default |" in index
+    failed = json.loads((tmp_path / "bad_scene" / "run.json").read_text())
+    assert failed["status"] == "failed" and "deliberate failure" in failed["message"]
+    (tmp_path / "by-hand").mkdir()
+    (tmp_path / "by-hand" / "README.md").write_text("# not a scene run\n")
+    assert cli.main(["run", "ok-scene", "-o", str(tmp_path), "--full"]) == 0
+    index = (tmp_path / "README.md").read_text()
+    assert "| [by-hand](by-hand/README.md) |  | unknown (no run.json) |" in index
+    assert "| ok | full |" in index
+    capsys.readouterr()
+    assert cli.main(["run", "ok-scene", "-o", str(tmp_path), "--full", "--fast"]) == 2
 
 
 def _sweep_scene(ctx):
@@ -128,8 +169,8 @@ def _sweep_scene(ctx):
 
 def test_run_passes_the_sweep_executor_to_the_scenes(registry, tmp_path, capsys):
     scenes.register_scene(Scene("sweep-scene", "A sweep", "", _sweep_scene))
-    assert cli.main(["run", "sweep-scene", "-o", str(tmp_path / "serial")]) == 0
-    assert cli.main(["run", "sweep-scene", "-o", str(tmp_path / "pool"), "--workers", "2"]) == 0
+    assert cli.main(["run", "sweep-scene", "-o", str(tmp_path / "serial"), "--workers", "1"]) == 0
+    assert cli.main(["run", "sweep-scene", "-o", str(tmp_path / "pool")]) == 0  # default: a process per core
     serial = pd.read_csv(tmp_path / "serial" / "sweep-scene" / "sweep.csv")
     pool = pd.read_csv(tmp_path / "pool" / "sweep-scene" / "sweep.csv")
     assert serial["x"].tolist() == pool["x"].tolist() == [1, 2, 3]
@@ -149,7 +190,7 @@ def test_run_all_continues_after_failure_and_exits_nonzero(registry, tmp_path, c
     assert "RuntimeError: deliberate failure in scene body" in error_txt and "Traceback" in error_txt
     assert (tmp_path / "ok-scene" / "parabola.png").exists()
     index = (tmp_path / "README.md").read_text()
-    assert "| failed |" in index and "| ok |" in index
+    assert "| failed (see bad_scene/error.txt) |" in index and "| ok |" in index
 
 
 def test_run_scene_raises_scene_error_and_clears_stale_error(tmp_path):
@@ -272,9 +313,9 @@ def test_failed_scene_removes_the_stale_files_of_an_earlier_run(tmp_path):
     failing = Scene("ok-scene", "Fails this time", "", _broken_scene)
     with pytest.raises(SceneError):
         run_scene(failing, tmp_path)
-    assert sorted(p.name for p in folder.iterdir()) == ["error.txt"]
+    assert sorted(p.name for p in folder.iterdir()) == ["error.txt", "run.json"]  # run.json: this run's record
     text = (folder / "error.txt").read_text()
-    assert "removed 4 file(s) of an earlier run" in text and "parabola.csv" in text
+    assert "removed 6 file(s) of an earlier run" in text and "parabola.csv" in text
 
 
 def test_output_path_that_is_a_file_is_a_one_line_error(registry, tmp_path, capsys):

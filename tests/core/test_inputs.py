@@ -190,11 +190,13 @@ def test_duplicate_quantity_in_range_table_is_refused(tmp_path):
 
 
 @pytest.mark.parametrize("domain", ["railway", "biomech", "coaster"])
-def test_readme_range_tables_equal_the_data(domain):
-    """The README's "Checked inputs" tables are RangeTable.to_markdown() of the shipped CSVs:
-    a range changed in the data without the README (or the reverse) fails here."""
+def test_docs_range_tables_equal_the_data(domain):
+    """The "Checked inputs" tables of the documentation (docs/user-guide/checked-inputs.md) are
+    RangeTable.to_markdown() of the shipped CSVs: a range changed in the data without the page
+    (or the reverse) fails here."""
     from core.paths import data_path, repo_root
 
-    readme = (repo_root() / "README.md").read_text(encoding="utf-8")
+    page = (repo_root() / "docs" / "user-guide" / "checked-inputs.md").read_text(encoding="utf-8")
     table = RangeTable.from_csv(data_path(domain, "plausible_ranges.csv")).to_markdown()
-    assert table in readme, f"README's {domain} range table differs from data/{domain}/plausible_ranges.csv"
+    assert table in page, (f"the {domain} range table of docs/user-guide/checked-inputs.md differs from "
+                           f"data/{domain}/plausible_ranges.csv")

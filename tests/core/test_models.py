@@ -156,6 +156,14 @@ def test_chain_definition():
         M.n_link_chain(0)
 
 
+def test_crank_geometry_recovers_crank_and_rod_lengths():
+    """r = |A − O| and l = |B − A| from the joints, at any initial crank angle and for overridden lengths."""
+    r, l = M.crank_geometry(M.slider_crank())
+    assert r == pytest.approx(0.15, abs=1e-15) and l == pytest.approx(0.30, abs=1e-15)
+    r, l = M.crank_geometry(M.slider_crank(crank_angle0=1.1, l1=0.1, l2=0.45, J1=0.01, J2=0.01))
+    assert r == pytest.approx(0.1, abs=1e-14) and l == pytest.approx(0.45, abs=1e-14)
+
+
 def test_chain_reference_matches_single_rod_energy():
     # N = 1 is a compound pendulum; the reference must conserve its energy to ~rtol
     tip, hist = n_link_chain_reference(1, t_end=1.0)

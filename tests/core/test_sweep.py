@@ -7,7 +7,7 @@ import concurrent.futures
 import numpy as np
 import pytest
 
-from core.sweep import run_sweep
+from core.sweep import executor_workers, run_sweep
 
 
 def damped_walk(case: dict) -> dict:
@@ -62,3 +62,16 @@ def test_failure_names_case(use_pool):
 def test_rejects_non_executor():
     with pytest.raises(TypeError, match="Executor"):
         run_sweep(fail_on_three, [1], executor=object())
+
+
+def test_executor_workers():
+    assert executor_workers(None) == 1
+    with concurrent.futures.ThreadPoolExecutor(max_workers=3) as pool:
+        assert executor_workers(pool) == 3
+    with concurrent.futures.ProcessPoolExecutor(max_workers=2) as pool:
+        assert executor_workers(pool) == 2
+
+    class Elsewhere(concurrent.futures.Executor):  # a cluster's executor: size not known
+        pass
+
+    assert executor_workers(Elsewhere()) is None

@@ -112,6 +112,28 @@ def test_serial_equals_process_pool_for_deterministic_columns():
     pd.testing.assert_frame_equal(serial[cols], parallel[cols], check_exact=True)
 
 
+def test_problem_set_on_a_given_executor_equals_serial():
+    """run_problem_set on the caller's executor (the work-precision scene passes its sweep executor):
+    the deterministic columns equal the serial run's; the executor stays open; jobs and executor
+    together are refused."""
+    kw = dict(methods=["rk45-projection", "hht"], repeats=1)
+    serial = wp.run_problem_set([CHAIN], "quick", **kw)
+    with ProcessPoolExecutor(max_workers=2) as ex:
+        parallel = wp.run_problem_set([CHAIN], "quick", executor=ex, **kw)
+        assert ex.submit(abs, -1).result() == 1  # not shut down
+        with pytest.raises(ValueError, match="not both"):
+            wp.run_problem_set([CHAIN], "quick", jobs=2, executor=ex, **kw)
+    cols = wp.DETERMINISTIC_COLUMNS
+    pd.testing.assert_frame_equal(serial[cols], parallel[cols], check_exact=True)
+
+
+def test_work_precision_notes_name_grid_workers_and_measures():
+    notes = wp.work_precision_notes([CHAIN, "andrews"], "quick", 2)
+    assert notes.startswith("Grid `quick`; 2 worker process(es)")
+    assert f"| {CHAIN} | {wp.PROBLEMS[CHAIN].error_measure} |" in notes and "| andrews |" in notes
+    assert "the workers of a distributed executor" in wp.work_precision_notes([CHAIN], "quick", None)
+
+
 def test_pendulum_exact_solution_matches_an_independent_integration():
     g, l, th0 = 9.81, 1.0, np.pi / 2
     t = np.array([0.0, 0.3, 1.7, 25.0, 100.0])

@@ -1,7 +1,7 @@
 """Assessment quantities (railway.assessment): Nadal limit, Hertz pressure, wear number, Y/Q.
 
 Oracles: the trigonometric identity of Nadal's formula and the statics of a flange contact on
-the point of climbing (built independently with the contact frame of railway.creepage); a
+the point of climbing (built independently with the contact frame of railway.contact.creepage); a
 quadrature of the Hertz pressure distribution; CONTACT's own frictional power for the
 Manchester cases (eve70a/CONTACT rev. 2447, data/railway/manchester_contact_a22_contact_rev2447.csv).
 """
@@ -22,8 +22,8 @@ from railway.assessment import (
     wheel_force_statistics,
     wheel_forces_track,
 )
-from railway.creepage import contact_frame
-from railway.manchester_contact import load_contact_reference
+from railway.contact.creepage import contact_frame
+from railway.contact.manchester_contact import load_contact_reference
 
 
 # ------------------------------------------------------------------------------------------
@@ -47,7 +47,7 @@ def test_flange_at_the_point_of_climbing_has_the_nadal_quotient(side, gamma_deg,
     """Statics of Nadal's criterion: on a leading flange with large angle of attack the wheel
     material slides down the flange, so the friction force mu N on the wheel acts up the flange
     slope; then Y/Q of the wheel equals (tan g - mu)/(1 + mu tan g).  The contact is built
-    from geometry (normal leaning towards the track centre, the frame of railway.creepage) and
+    from geometry (normal leaning towards the track centre, the frame of railway.contact.creepage) and
     turned into Y, Q by wheel_forces_track."""
     g = np.radians(gamma_deg)
     N = 25e3

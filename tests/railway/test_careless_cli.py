@@ -17,7 +17,7 @@ import pytest
 
 from core.cli import check_option, main
 from core.inputs import ImplausibleValueError
-from railway.creep_curve import creep_curve
+from railway.contact.creep_curve import creep_curve
 from railway.ranges import ranges
 
 

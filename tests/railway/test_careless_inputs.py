@@ -1,7 +1,7 @@
 """Careless inputs to the railway domain (issue 21): each ends in one clear line or a named warning.
 
-The vehicle file (railway.vehicle_file), the keyword arguments of build_vehicle, the track and its
-irregularities (railway.track) and the profile readers (railway.profiles) are given the inputs a
+The vehicle file (railway.vehicles.vehicle_file), the keyword arguments of build_vehicle, the track and its
+irregularities (railway.track) and the profile readers (railway.contact.profiles) are given the inputs a
 hurried user writes -- units slipped (tonnes, kN/m, mm), keys misspelt, geometry that contradicts
 itself, values out of range, names mistyped -- and every case asserts the exact outcome: the error
 type and a message naming the file / table / key / argument and the likely slip.  Then the shipped
@@ -26,7 +26,7 @@ from core.errors import (
 from core.inputs import ImplausibleValueError, UnitError
 from railway.ranges import IrregularityStepWarning, SuspensionGeometryWarning, ranges
 from railway.track import Curve, Irregularities, Straight, Track, Transition, parse_inclination
-from railway.vehicle import VehicleDefinition, build_vehicle
+from railway.vehicles.vehicle import VehicleDefinition, build_vehicle
 
 COACH = Path(VehicleDefinition.manchester().path)
 TEXT = COACH.read_text(encoding="utf-8")
@@ -213,7 +213,7 @@ def test_not_toml_and_no_file(tmp_path):
 
 
 def test_wheel_profile_file_in_metres(tmp_path):
-    from railway.profiles import s1002_exact
+    from railway.contact.profiles import s1002_exact
 
     y = np.linspace(-60.0, 55.0, 231)
     (tmp_path / "wheel_m.txt").write_text("\n".join(f"{a * 1e-3:.7f} {b * 1e-3:.7f}" for a, b in
@@ -274,7 +274,7 @@ def test_shipped_vehicle_file_and_ranges_pass(coach):
     rows = [line.split(",")[0] for line in Path(R.source).read_text(encoding="utf-8").splitlines()
             if line.strip() and not line.startswith("#")][1:]
     assert len(rows) == len(set(rows)), sorted({q for q in rows if rows.count(q) > 1})
-    from railway.vehicle_file import VehicleFile  # noqa: F401  (importing builds the schema: names resolve)
+    from railway.vehicles.vehicle_file import VehicleFile  # noqa: F401  (importing builds the schema: names resolve)
 
     for q in ("speed", "friction_coefficient", "vehicle_lateral_offset", "curve_radius", "cant", "cant_base",
               "transition_length", "track_segment_length", "irregularity_amplitude", "irregularity_sample_spacing",
@@ -505,7 +505,8 @@ def test_curves_with_units_equal_the_si_numbers():
 
 
 def test_scene_tracks_raise_no_false_alarm():
-    from railway.vehicle_scenes import curving_track, irregularities
+    from railway.vehicles.curving import curving_track
+    from railway.vehicles.ride import irregularities
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -517,7 +518,7 @@ def test_scene_tracks_raise_no_false_alarm():
 # profile readers
 # ---------------------------------------------------------------------------------------------
 def test_rail_profile_in_metres(tmp_path):
-    from railway.profiles import RailProfile
+    from railway.contact.profiles import RailProfile
 
     u = np.linspace(-0.035, 0.035, 71)
     f = tmp_path / "rail_m.txt"
@@ -528,7 +529,7 @@ def test_rail_profile_in_metres(tmp_path):
 
 
 def test_wheel_profile_points_in_metres_are_not_answered_with_the_flange_side():
-    from railway.profiles import WheelProfile, s1002_exact
+    from railway.contact.profiles import WheelProfile, s1002_exact
 
     y = np.linspace(-60.0, 55.0, 231)
     with pytest.raises(InputError, match=r"values look like metres") as info:
@@ -563,7 +564,7 @@ def test_misspelt_creep_parameter(coach):
 # ---------------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def onset_table():
-    from railway.contact_geometry import contact_geometry_table, contact_transitions
+    from railway.contact.geometry import contact_geometry_table, contact_transitions
 
     t = contact_geometry_table(np.linspace(0.0, 0.008, 17))
     return t, contact_transitions(t)
@@ -571,7 +572,7 @@ def onset_table():
 
 def test_flange_onset_bisection_failure_is_a_numerical_failure(onset_table):
     from core.errors import NumericalFailure
-    from railway.contact_geometry import flange_contact_onset
+    from railway.contact.geometry import flange_contact_onset
 
     t, tr = onset_table
     y_f, _ = flange_contact_onset(t, transitions=tr)
@@ -589,7 +590,7 @@ def test_flange_onset_bisection_failure_is_a_numerical_failure(onset_table):
 
 
 def test_flange_onset_with_transitions_of_another_table(onset_table):
-    from railway.contact_geometry import flange_contact_onset
+    from railway.contact.geometry import flange_contact_onset
 
     t, tr = onset_table
     with pytest.raises(InputError, match=r"flange contact onset of wheel S1002 on rail UIC60, gauge 1435 mm.*: the "
@@ -615,7 +616,7 @@ RAIL_CROWN_CASES = [
 
 @pytest.mark.parametrize("shape,pattern", [c[1:] for c in RAIL_CROWN_CASES], ids=[c[0] for c in RAIL_CROWN_CASES])
 def test_rail_profile_without_a_crown_is_refused_naming_the_file(tmp_path, shape, pattern):
-    from railway.profiles import RailProfile
+    from railway.contact.profiles import RailProfile
 
     u = np.arange(-36.0, 37.0)
     f = tmp_path / "rail.txt"
@@ -629,7 +630,7 @@ def test_rail_mounting_refuses_a_profile_without_a_crown():
     """A profile made in code (not read through the reader) is checked by RailMounting itself:
     no ZeroDivisionError from the Newton iterations on the top and the gauge point."""
     from core.curves import PiecewisePoly
-    from railway.profiles import RailProfile
+    from railway.contact.profiles import RailProfile
     from railway.track import RailMounting
 
     flat = RailProfile(PiecewisePoly(np.array([-0.036, 0.036]), np.zeros((1, 1))), name="flat head")
@@ -641,7 +642,7 @@ def test_rail_mounting_refuses_a_profile_without_a_crown():
 
 
 def test_profile_file_with_nan_names_the_line_with_plain_floats(tmp_path):
-    from railway.profiles import RailProfile, WheelProfile
+    from railway.contact.profiles import RailProfile, WheelProfile
 
     f = tmp_path / "rail_nan.txt"
     f.write_text("# u v\n-3 -0.1\n-1 0.0\n0 nan\n1 0.0\n3 -0.1\n", encoding="utf-8")
@@ -661,7 +662,7 @@ def test_profile_file_with_nan_names_the_line_with_plain_floats(tmp_path):
 
 @pytest.mark.parametrize("reader", ["rail", "wheel"])
 def test_binary_profile_file_is_named(tmp_path, reader):
-    from railway.profiles import RailProfile, WheelProfile
+    from railway.contact.profiles import RailProfile, WheelProfile
 
     f = tmp_path / "scan.png"
     f.write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\xff\xfe")
@@ -674,10 +675,10 @@ def test_binary_profile_file_is_named(tmp_path, reader):
         RailProfile.from_file(g) if reader == "rail" else WheelProfile.from_file(g, r0=0.46)
 
 
-from railway.creep import Polach2005  # noqa: E402
-from railway.creep_curve import creep_curve  # noqa: E402
-from railway.creepage import creepages  # noqa: E402
-from railway.two_point import conical_wheel_points  # noqa: E402
+from railway.contact.creep import Polach2005  # noqa: E402
+from railway.contact.creep_curve import creep_curve  # noqa: E402
+from railway.contact.creepage import creepages  # noqa: E402
+from railway.contact.two_point import conical_wheel_points  # noqa: E402
 
 LIBRARY_CASES = [
     ("creep curve without G or E",
@@ -724,7 +725,7 @@ def test_rigid_contact_failure_is_a_numerical_failure(monkeypatch):
     """A shift whose iteration does not converge (forced here by one iteration) ends in a
     NumericalFailure naming the profiles, the gauge and the shift, not a RuntimeError."""
     from core.errors import NumericalFailure
-    from railway.contact_geometry import rigid_contact
+    from railway.contact.geometry import rigid_contact
 
     with pytest.raises(NumericalFailure, match=r"rigid contact of wheel S1002 on rail UIC60, gauge 1435 mm: no "
                                                r"convergence: largest gap .* m after 1 iterations at lateral shift "
@@ -735,7 +736,7 @@ def test_rigid_contact_failure_is_a_numerical_failure(monkeypatch):
 def test_rail_mounting_gauge_uses_the_range_table():
     """One source of truth: RailMounting refuses a gauge outside the `gauge` row of
     plausible_ranges.csv (0.6-1.7 m), with the slip named, and lets a deliberate one through."""
-    from railway.contact_geometry import contact_geometry_table
+    from railway.contact.geometry import contact_geometry_table
     from railway.track import RailMounting
 
     g = ranges()["gauge"]
@@ -808,15 +809,15 @@ def test_speed_control_past_the_end_of_an_open_track_names_the_end(coach):
 # misspelt keyword arguments of the public functions: the closest accepted one is named
 # ---------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("call, pattern", [
-    (lambda: importlib.import_module("railway.vehicle").build_vehicle(None, None, 30.0, sped=20.0),
+    (lambda: importlib.import_module("railway.vehicles.vehicle").build_vehicle(None, None, 30.0, sped=20.0),
      r"build_vehicle\(\): unknown option 'sped'; did you mean 'speed'\?"),
-    (lambda: importlib.import_module("railway.contact_geometry").rigid_contact([0.0], gage=1.435),
+    (lambda: importlib.import_module("railway.contact.geometry").rigid_contact([0.0], gage=1.435),
      r"rigid_contact\(\): unknown option 'gage'; did you mean 'gauge'\?"),
-    (lambda: importlib.import_module("railway.contact_geometry").contact_geometry_table([0.0], inclinaton=0.025),
+    (lambda: importlib.import_module("railway.contact.geometry").contact_geometry_table([0.0], inclinaton=0.025),
      r"contact_geometry_table\(\): unknown option 'inclinaton'; did you mean 'inclination'\?"),
-    (lambda: importlib.import_module("railway.quasi_static").quasi_static_contact([0.0], 5e4, yaww=0.0),
+    (lambda: importlib.import_module("railway.contact.quasi_static").quasi_static_contact([0.0], 5e4, yaww=0.0),
      r"quasi_static_contact\(\): unknown option 'yaww'; did you mean 'yaw'\?"),
-    (lambda: importlib.import_module("railway.wheel_rail").contact_history(None, None, at_="steps"),
+    (lambda: importlib.import_module("railway.vehicles.wheel_rail").contact_history(None, None, at_="steps"),
      r"contact_history\(\): unknown option 'at_'; did you mean 'at'\?"),
 ], ids=["build_vehicle sped", "rigid_contact gage", "contact_geometry_table inclinaton", "quasi_static yaww",
         "contact_history at_"])
@@ -828,27 +829,28 @@ def test_misspelt_keyword_names_the_closest(call, pattern):
 
 
 # ---------------------------------------------------------------------------------------------
-# the README's "Checked inputs" snippets run here, so they cannot go stale
+# the "Checked inputs" snippets of the documentation (docs/user-guide/checked-inputs.md) run
+# here, so they cannot go stale
 # ---------------------------------------------------------------------------------------------
 def _readme_block(lang, after):
     from core.paths import repo_root
 
-    text = (repo_root() / "README.md").read_text(encoding="utf-8")
+    text = (repo_root() / "docs" / "user-guide" / "checked-inputs.md").read_text(encoding="utf-8")
     i = text.index(f"```{lang}\n", text.index(after)) + len(lang) + 4
     return text[i:text.index("```", i)]
 
 
 def test_readme_units_snippet_equals_the_manchester_file_in_si():
-    """The README's TOML snippet (values with units) laid over the Manchester file gives the same
+    """The docs' TOML snippet (values with units) laid over the Manchester file gives the same
     vehicle as the SI file, to the digits the snippet writes."""
     import tomllib
 
     from core.paths import data_path
-    from railway.vehicle import VehicleDefinition
+    from railway.vehicles.vehicle import VehicleDefinition
 
     path = data_path("railway", "vehicles", "manchester_coach.toml")
     base = tomllib.loads(path.read_text(encoding="utf-8"))
-    snippet = tomllib.loads(_readme_block("toml", "### Railway vehicles and track"))
+    snippet = tomllib.loads(_readme_block("toml", "## Railway vehicles and track"))
     for table, keys in snippet.items():
         base[table].update(keys)
     with_units = VehicleDefinition.from_dict(base, base_dir=path.parent)
@@ -861,14 +863,14 @@ def test_readme_units_snippet_equals_the_manchester_file_in_si():
 
 
 def test_readme_example_message_is_the_one_the_code_writes(tmp_path):
-    """The intro's example line of README "Checked inputs" is the message a 32 kg car body gets."""
+    """The intro's example line of the docs' "Checked inputs" page is the message a 32 kg car body gets."""
     from core.paths import data_path
-    from railway.vehicle import VehicleDefinition
+    from railway.vehicles.vehicle import VehicleDefinition
 
     text = data_path("railway", "vehicles", "manchester_coach.toml").read_text(encoding="utf-8")
     f = tmp_path / "coach.toml"
     f.write_text(text.replace("mass = 32000.0 ", "mass = 32 ", 1), encoding="utf-8")
-    line = _readme_block("", "## Checked inputs").strip()
+    line = _readme_block("text", "# Checked inputs").strip()
     with pytest.raises(ImplausibleValueError) as info:
         VehicleDefinition.from_toml(f)
     assert str(info.value) == f"{tmp_path}/{line}"

@@ -8,15 +8,15 @@ from scipy.integrate import solve_ivp
 from scipy.spatial import cKDTree
 
 from railway.cli import register, run_contact_table
-from railway.contact_geometry import (
+from railway.contact.geometry import (
     conicity_table,
     contact_geometry_table,
     equivalent_conicity,
     flange_contact_onset,
     rigid_contact,
 )
-from railway.contact_search import wheelset_pose
-from railway.profiles import WheelProfile
+from railway.contact.search import wheelset_pose
+from railway.contact.profiles import WheelProfile
 from railway.track import RailMounting, Track
 
 

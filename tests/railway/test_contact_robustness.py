@@ -8,7 +8,7 @@ vertical gap to the mounted rail (sampled at 1 um of arc, linear interpolation i
 coordinate) is g_v(y) = Z_w(y) - Z_r(Y_w(y)); a(phi) = min_y g_v is the approach of that wheel,
 and a vertical translation z adds z to every gap.  The rigid contact therefore solves
 a_L(phi) = a_R(phi) (Brent's method on phi) with z = -a_L, and each wheel touches at the
-argmin of its g_v.  At a pose from :func:`railway.contact_geometry.rigid_contact` both
+argmin of its g_v.  At a pose from :func:`railway.contact.geometry.rigid_contact` both
 minima must be zero (touching, no hidden penetration anywhere on the profile).
 
 Sampling error of the oracle: the minimum over samples 10 um apart exceeds the true minimum
@@ -25,23 +25,23 @@ from scipy.optimize import brentq
 
 from core.errors import InputError
 from railway.cli import ConicityResolutionWarning, register
-from railway.contact_geometry import (
+from railway.contact.geometry import (
     conicity_table,
     contact_geometry_table,
     contact_transitions,
     flange_contact_onset,
     rigid_contact,
 )
-from railway.contact_search import ContactSearch, wheelset_pose
-from railway.creep_curve import creep_curve
-from railway.profiles import (
+from railway.contact.search import ContactSearch, wheelset_pose
+from railway.contact.creep_curve import creep_curve
+from railway.contact.profiles import (
     RailProfile,
     WheelProfile,
     data_resolution,
     s1002_exact,
     uic60_exact,
 )
-from railway.quasi_static import quasi_static_contact, quasi_static_summary
+from railway.contact.quasi_static import quasi_static_contact, quasi_static_summary
 from railway.track import RailMounting, Track
 
 L_WHEEL = 0.5 * 1.360 + 0.070  # taping line from the wheelset centre (m)

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from railway.contact_search import ContactSearch, wheelset_pose
-from railway.profiles import WheelProfile
-from railway.surfaces import RailSurface, WheelSurface
+from railway.contact.search import ContactSearch, wheelset_pose
+from railway.contact.profiles import WheelProfile
+from railway.contact.surfaces import RailSurface, WheelSurface
 from railway.track import Curve, Irregularities, RailMounting, Straight, Track, Transition
 
 R0 = 0.46

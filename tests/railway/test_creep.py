@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 
 from core.errors import InputError, NameTakenError, UnknownNameError
-from railway.creep import (
+from railway.contact.creep import (
     CREEP_MODELS,
     CreepModel,
     Fastsim,
@@ -26,7 +26,7 @@ from railway.creep import (
     kalker_table_path,
     register_creep_model,
 )
-from railway.creep_curve import creep_curve, plot_creep_curve
+from railway.contact.creep_curve import creep_curve, plot_creep_curve
 
 # a typical tread contact: N = 100 kN, a = 6 mm (rolling), b = 4 mm, steel
 N0, A0, B0, G0, NU0, MU0 = 1e5, 6e-3, 4e-3, 8.1e10, 0.28, 0.3
@@ -313,7 +313,7 @@ def test_unknown_or_taken_names_raise_the_registry_errors():
     class Other(CreepModel):
         pass
 
-    with pytest.raises(NameTakenError, match="'polach2000' is taken by railway.creep.Polach2000"):
+    with pytest.raises(NameTakenError, match="'polach2000' is taken by railway.contact.creep.Polach2000"):
         register_creep_model("polach2000", Other)
     assert CREEP_MODELS["polach2000"] is Polach2000
     assert register_creep_model("polach2000", Polach2000) is Polach2000  # same class again: no-op
@@ -402,7 +402,7 @@ def test_spin_moment_bounded_by_linear_moment(model):
 def test_cli_creep_curve(tmp_path, capsys):
     import argparse
 
-    from railway.cli_creep import add_creep_curve_parser
+    from railway.cli.creep_curve import add_creep_curve_parser
 
     parser = argparse.ArgumentParser()
     rail = parser.add_subparsers().add_parser("railway").add_subparsers()

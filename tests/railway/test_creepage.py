@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from railway.creepage import contact_frame, creepages
+from railway.contact.creepage import contact_frame, creepages
 
 R0 = 0.46
 V = 30.0

@@ -1,7 +1,7 @@
-"""Vehicles start in equilibrium anywhere on the track (railway.curving_start, issue 21).
+"""Vehicles start in equilibrium anywhere on the track (railway.vehicles.curving_start, issue 21).
 
 The start of a run in a curve or a transition is the quasi-static curving state of the model
-itself (:func:`railway.curving_start.quasi_static_curving`): checked here by running the model
+itself (:func:`railway.vehicles.curving_start.quasi_static_curving`): checked here by running the model
 from it (it must stay there), by the lateral force balance of the whole vehicle against the
 closed form m (V^2 kappa cos(phi) + g sin(phi)), and on straight track against the static
 preload.  The runs use the scenes' integrator and tolerance (jit-dop853, rtol 1e-4).
@@ -13,8 +13,8 @@ import pytest
 from core.errors import InputError
 from core.integrators import simulate
 from railway.track import Curve, Straight, Track, Transition
-from railway.vehicle import GRAVITY, VehicleDefinition, build_vehicle
-from railway.wheel_rail import contact_history
+from railway.vehicles.vehicle import GRAVITY, VehicleDefinition, build_vehicle
+from railway.vehicles.wheel_rail import contact_history
 
 RADIUS, V, RTOL, T_RUN = 200.0, 20.0, 1e-4, 0.3
 
@@ -98,7 +98,7 @@ def test_the_curving_scene_still_starts_on_straight_track_from_the_same_model(co
     """railway-curving builds at s0 = 35 m, on the straight before the curve: the model and its
     start are those of a straight track, bit for bit (the straight reference geometry of the
     suspension applies only under a curved vehicle)."""
-    from railway.vehicle_scenes import curving_track
+    from railway.vehicles.curving import curving_track
 
     a = vehicle(coach, curving_track(), 35.0)
     b = vehicle(coach, Track.straight(curving_track().length), 35.0)

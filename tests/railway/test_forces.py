@@ -1,7 +1,7 @@
-"""Wheel-rail contact forces of a contact search (railway.forces).
+"""Wheel-rail contact forces of a contact search (railway.contact.forces).
 
 Oracles: the compiled kernel against the reference path built from the validated modules
-(core.contact_laws, railway.creepage, railway.creep); the kernel's normal law against
+(core.contact_laws, railway.contact.creepage, railway.contact.creep); the kernel's normal law against
 core.contact_laws; every creep law through ContactForces against the law called directly;
 Hertz's closed form N = K_h delta^1.5 at zero penetration rate; the force-opposes-creepage sign;
 force balance of the global force vector.
@@ -12,10 +12,10 @@ import pytest
 
 from core.contact_laws import HYSTERESIS_LAWS, hertz_from_penetration, hysteresis_force, relative_curvatures
 from core.errors import InputError, UnknownNameError
-from railway._kernels import HAVE_NUMBA
-from railway.contact_search import ContactSearch, wheelset_pose
-from railway.creep import CREEP_MODELS, CreepModel, get_creep_model, register_creep_model
-from railway.forces import (
+from railway.contact.search.kernels import HAVE_NUMBA
+from railway.contact.search import ContactSearch, wheelset_pose
+from railway.contact.creep import CREEP_MODELS, CreepModel, get_creep_model, register_creep_model
+from railway.contact.forces import (
     FORCE_KEYS,
     ContactForces,
     _compiled_normal_law,

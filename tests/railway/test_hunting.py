@@ -1,11 +1,11 @@
-"""Closed forms of hunting (railway.hunting) against the eigenvalues of their own equations."""
+"""Closed forms of hunting (railway.vehicles.hunting) against the eigenvalues of their own equations."""
 
 import numpy as np
 import pytest
 from scipy.optimize import brentq
 
 from core.errors import InputError
-from railway.hunting import (
+from railway.vehicles.hunting import (
     klingel_wavelength,
     suspended_wheelset_coefficients,
     suspended_wheelset_critical_speed,

@@ -1,10 +1,10 @@
 """Like-for-like validation of hunting (issue 21): the multibody suspended wheelset against the
-linear wheelset of railway.hunting with the same terms switched on.
+linear wheelset of railway.vehicles.hunting with the same terms switched on.
 
 Oracles: the classical two-degree-of-freedom wheelset (Wickens 2003, ch. 2; Routh–Hurwitz closed
-form of railway.hunting) against the multibody wheelset reduced by ``TEXTBOOK`` (no gyroscopic
+form of railway.vehicles.hunting) against the multibody wheelset reduced by ``TEXTBOOK`` (no gyroscopic
 moment, no roll rate in the creepages, no tilt of the normal forces, creep in the wheelset frame,
-no spin creepage); the complete linear wheelset (railway.hunting.LinearWheelset, every term on)
+no spin creepage); the complete linear wheelset (railway.vehicles.hunting.LinearWheelset, every term on)
 against the full multibody wheelset.  Both in the nominal-spin formulation, core's
 linearize/eigen, with the closed-form inputs (conicity, roll, contact angle, Hertz and Kalker
 coefficients) from the rigid contact geometry only.  Conical wheels (cone 1:40 ... 0.4) on UIC60
@@ -26,10 +26,10 @@ import pytest
 from scipy.optimize import brentq
 
 from core.errors import InputError, ModelError
-from railway.forces import ContactForces
-from railway.hunting import TERMS, LinearWheelset, suspended_wheelset_critical_speed
-from railway.two_point import conical_wheel
-from railway.wheelset_models import TEXTBOOK, eigen_critical_speed, linear_wheelset, suspended_wheelset
+from railway.contact.forces import ContactForces
+from railway.vehicles.hunting import TERMS, LinearWheelset, suspended_wheelset_critical_speed
+from railway.contact.two_point import conical_wheel
+from railway.vehicles.wheelset_models import TEXTBOOK, eigen_critical_speed, linear_wheelset, suspended_wheelset
 
 K = dict(k_y=3e5, k_psi=3e5)
 P = dict(m=1813.0, I=1120.0, k_y=3e5, k_psi=3e5, f11=2.9e6, f22=2.6e6, l=0.753, r0=0.46, conicity=0.0256)

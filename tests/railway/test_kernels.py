@@ -1,10 +1,10 @@
-"""Unit tier: the allocation-free helpers of railway._kernels against the library routines they
+"""Unit tier: the allocation-free helpers of railway.contact.search.kernels against the library routines they
 stand in for, bit for bit (the vehicle runs rely on the results being unchanged)."""
 
 import numpy as np
 import pytest
 
-from railway import _kernels as K
+from railway.contact.search import kernels as K
 
 pytestmark = pytest.mark.skipif(not K.HAVE_NUMBA, reason="numba not installed")
 

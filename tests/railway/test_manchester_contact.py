@@ -1,5 +1,5 @@
 """Manchester contact benchmark, Case A-2.2, against CONTACT's reference results
-(railway.manchester_contact, scene railway-manchester-contact).
+(railway.contact.manchester_contact, scene railway-manchester-contact).
 
 Reference: CONTACT's own results for its example (eve70a/CONTACT, examples/mbench_a22_{left,
 right}.ref_out, Revision 2447, Apache-2.0), stored in
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from core.scenes import run_scene
-from railway.manchester_contact import (
+from railway.contact.manchester_contact import (
     compare_with_contact,
     contact_reference_per_wheel,
     load_contact_reference,

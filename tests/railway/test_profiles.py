@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from railway.profiles import (
+from railway.contact.profiles import (
     DATA_DIR,
     RailProfile,
     WheelProfile,

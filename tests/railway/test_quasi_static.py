@@ -1,4 +1,4 @@
-"""Quasi-static elastic wheel-rail contact under vertical wheel loads (railway.quasi_static).
+"""Quasi-static elastic wheel-rail contact under vertical wheel loads (railway.contact.quasi_static).
 
 Oracles: the vertical force balance itself; Hertz's approach for the load along the normal
 (hertz_from_load, independent of the penetration-driven Newton iteration); mirror symmetry;
@@ -12,8 +12,8 @@ import pytest
 
 from core.contact_laws import hertz_from_load
 from railway.cli import register
-from railway.quasi_static import quasi_static_contact
-from railway.two_point import conical_wheel, two_point_contact
+from railway.contact.quasi_static import quasi_static_contact
+from railway.contact.two_point import conical_wheel, two_point_contact
 
 Q = 100e3
 

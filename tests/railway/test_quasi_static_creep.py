@@ -1,5 +1,5 @@
-"""Quasi-static rolling with creep forces in the balance (railway.quasi_static.quasi_static_rolling)
-and the Polach (2005) parameter sets (railway.creep).
+"""Quasi-static rolling with creep forces in the balance (railway.contact.quasi_static.quasi_static_rolling)
+and the Polach (2005) parameter sets (railway.contact.creep).
 
 Oracles: the equilibrium conditions themselves (vertical force of each wheel, free rolling),
 mirror symmetry of the centred wheelset, the frictionless solver quasi_static_contact (an
@@ -13,8 +13,8 @@ import pytest
 
 from core.errors import InputError, UnknownNameError
 from railway.assessment import nadal_limit
-from railway.creep import Polach2005, kalker_coefficients, polach2005_parameter_sets
-from railway.quasi_static import quasi_static_contact, quasi_static_rolling, quasi_static_wheel_table
+from railway.contact.creep import Polach2005, kalker_coefficients, polach2005_parameter_sets
+from railway.contact.quasi_static import quasi_static_contact, quasi_static_rolling, quasi_static_wheel_table
 
 Q = 100e3
 V = 20.0

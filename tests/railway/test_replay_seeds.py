@@ -1,8 +1,8 @@
 """The replay of a run's contact search state between its output rows (issue 21, "statistics from
-dense data"): :func:`railway.wheel_rail.contact_history` at coarse outputs reports the forces the
+dense data"): :func:`railway.vehicles.wheel_rail.contact_history` at coarse outputs reports the forces the
 run applied.
 
-A vehicle started mid-curve at 20 m/s (the quasi-static start of :mod:`railway.curving_start`)
+A vehicle started mid-curve at 20 m/s (the quasi-static start of :mod:`railway.vehicles.curving_start`)
 runs steadily: replayed at every accepted step, no wheel load moves by more than 0.6 N in 0.3 s.
 Replayed at 50 ms outputs with the seeds carried between the rows through *chords* (positions
 interpolated linearly), the rear bogie's leading outer wheel (wheelset 3 right) showed a
@@ -25,8 +25,8 @@ from core import frames
 from core.integrators import simulate
 from core.model import ModelBuilder
 from railway.track import Curve, Straight, Track, Transition
-from railway.vehicle import GRAVITY, VehicleDefinition, build_vehicle
-from railway.wheel_rail import _hermite_state, contact_history
+from railway.vehicles.vehicle import GRAVITY, VehicleDefinition, build_vehicle
+from railway.vehicles.wheel_rail import _hermite_state, contact_history
 
 RTOL, SPEED = 1e-4, 20.0
 
@@ -139,8 +139,8 @@ def test_the_curving_scene_replayed_at_20_hz_equals_its_replay_at_every_step():
     the Hermite, equal the replay at every step at the same times within rtol Q0.  The chord replay
     reported the leading outer wheel in flange contact at 2.40-2.55 s (s = 93.8-96.8 m; Q 8.6-12.1 kN
     too high) where the run had no flange contact (~25 s)."""
-    from railway.vehicle_scenes import RTOL as SCENE_RTOL
-    from railway.vehicle_scenes import run_curving
+    from railway.vehicles.curving import RTOL as SCENE_RTOL
+    from railway.vehicles.curving import run_curving
 
     res, veh = run_curving("polach2000", 20.0, T=2.6, record_steps=True)
     assert res.success, res.message

@@ -9,9 +9,9 @@ and the classical flange-lead estimate r tan(gamma) tan(psi).
 import numpy as np
 import pytest
 
-from railway.contact_geometry import contact_geometry_table
-from railway.profiles import WheelProfile
-from railway.two_point import conical_wheel, conical_wheel_points, gap_scan, local_minima, two_point_contact
+from railway.contact.geometry import contact_geometry_table
+from railway.contact.profiles import WheelProfile
+from railway.contact.two_point import conical_wheel, conical_wheel_points, gap_scan, local_minima, two_point_contact
 
 B_FLANK = 2.747477419  # slope of S1002 section E (70 deg flank)
 DY = 5e-6

@@ -1,7 +1,7 @@
-"""Railway vehicles in motion: closed forms, equilibrium and the sweep (railway.vehicle_scenes).
+"""Railway vehicles in motion: closed forms, equilibrium and the sweep (railway.vehicles: critical_speed, curving, ride).
 
 Oracles: Klingel's kinematic wavelength, the Routh-Hurwitz critical speed of the suspended
-wheelset (railway.hunting, itself tested against its own eigenvalues), the lateral force balance
+wheelset (railway.vehicles.hunting, itself tested against its own eigenvalues), the lateral force balance
 of a vehicle in a steady curve, and the serial sweep as reference for the parallel one.
 """
 
@@ -11,19 +11,17 @@ import numpy as np
 import pytest
 
 from core.integrators import simulate
-from railway.contact_geometry import contact_geometry_table
-from railway.hunting import klingel_wavelength
-from railway.two_point import conical_wheel
-from railway.vehicle_scenes import (
-    CURVE,
-    curve_window,
-    irregular_case,
-    linear_critical_speed,
-    run_curving,
-)
-from railway.vehicle import GRAVITY
-from railway.wheel_rail import contact_history
-from railway.wheelset_models import free_wheelset
+from railway.contact.geometry import contact_geometry_table
+from railway.vehicles.hunting import klingel_wavelength
+from railway.contact.two_point import conical_wheel
+from railway.vehicles.curving import CURVE
+from railway.vehicles.curving import curve_window
+from railway.vehicles.ride import irregular_track_case
+from railway.vehicles.critical_speed import linear_critical_speed
+from railway.vehicles.curving import run_curving
+from railway.vehicles.vehicle import GRAVITY
+from railway.vehicles.wheel_rail import contact_history
+from railway.vehicles.wheelset_models import free_wheelset
 
 
 def test_klingel_wavelength_of_a_free_conical_wheelset():
@@ -46,7 +44,7 @@ def test_klingel_wavelength_of_a_free_conical_wheelset():
     l = 0.5 * (1.360 + 0.140)  # taping lines (the cone's contact sits within 3 mm of them)
     for lam in (1.0 / 40.0, lam_e):
         assert L_sim == pytest.approx(klingel_wavelength(0.46, l, lam), rel=1e-2)
-    # a free wheelset is unstable at every speed (railway.hunting), slowly at 5 m/s: the
+    # a free wheelset is unstable at every speed (railway.vehicles.hunting), slowly at 5 m/s: the
     # amplitude grows, by 1.45 % over these 1.3 wavelengths (measured)
     assert y0 < np.max(np.abs(y)) < 1.05 * y0
 
@@ -119,10 +117,28 @@ def test_sweep_parallel_equals_serial():
     from core.sweep import run_sweep
 
     cases = [dict(speed=V, length=50.0, law="kalker_linear", seed=3) for V in (25.0, 35.0)]
-    serial = run_sweep(irregular_case, cases)
+    serial = run_sweep(irregular_track_case, cases)
     with concurrent.futures.ProcessPoolExecutor(max_workers=2) as ex:
-        parallel = run_sweep(irregular_case, cases, executor=ex)
+        parallel = run_sweep(irregular_track_case, cases, executor=ex)
     for (a, sa), (b, sb) in zip(serial, parallel):
         assert a == b
         for x, y in zip(sa, sb):
             np.testing.assert_array_equal(x, y)
+
+
+def test_the_threshold_speed_and_its_extrapolation_to_zero_rate():
+    """The run-down's threshold speed is the lowest speed still hunting, NaN for a run that never
+    hunted or never stopped; with a lag proportional to the rate the extrapolation through two
+    rates returns the fold's speed exactly (here the lags measured for the coach with Polach 2000:
+    1.95 and 0.99 m/s at 1 and 0.5 m/s², about V_nc = 58.74 m/s)."""
+    from railway.vehicles.critical_speed import HUNTING_AMPLITUDE, hunting_threshold_speed, zero_rate_speed
+
+    V = np.linspace(60.0, 50.0, 101)
+    amp = np.where(V > 55.05, 2 * HUNTING_AMPLITUDE, 0.1 * HUNTING_AMPLITUDE)
+    assert hunting_threshold_speed(V, amp) == pytest.approx(V[V > 55.05].min())
+    assert np.isnan(hunting_threshold_speed(V, np.full_like(V, 2 * HUNTING_AMPLITUDE)))
+    assert np.isnan(hunting_threshold_speed(V, np.zeros_like(V)))
+    V_nc, c = 58.74, 1.96
+    assert zero_rate_speed((1.0, 0.5), (V_nc - c * 1.0, V_nc - c * 0.5)) == pytest.approx(V_nc, abs=1e-12)
+    assert zero_rate_speed((2.0, 1.0, 0.5), (55.4, 56.79, 57.755)) == pytest.approx(58.72, abs=1e-9)
+    assert np.isnan(zero_rate_speed((1.0, 0.5), (np.nan, 57.0)))

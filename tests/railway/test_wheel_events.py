@@ -1,5 +1,5 @@
 """Wheel lift, peaks and exceedances from every accepted step (railway.assessment.
-wheel_event_statistics, railway.wheel_rail.contact_history at="steps"), and the failure
+wheel_event_statistics, railway.vehicles.wheel_rail.contact_history at="steps"), and the failure
 messages of the compiled path in the element's own words.
 
 Oracles: a wheelset dropped 1 mm onto its rails bounces (Lankarani-Nikravesh damping,
@@ -21,8 +21,8 @@ from core.integrators import simulate
 from core.signals import GridResolutionWarning
 from railway.assessment import wheel_event_statistics
 from railway.track import Track
-from railway.vehicle import GRAVITY, VehicleDefinition, build_vehicle
-from railway.wheel_rail import contact_history
+from railway.vehicles.vehicle import GRAVITY, VehicleDefinition, build_vehicle
+from railway.vehicles.wheel_rail import contact_history
 
 T_END = 0.1
 
@@ -32,8 +32,8 @@ def wheelset_model(sink=6e-5, speed=20.0, creep_law="kalker_linear"):
     (negative: above them), rolling at ``speed`` (tests/railway/test_wheel_rail.py)."""
     from core import frames
     from core.model import ModelBuilder
-    from railway.contact_geometry import rigid_contact
-    from railway.wheel_rail import WheelRailContact
+    from railway.contact.geometry import rigid_contact
+    from railway.vehicles.wheel_rail import WheelRailContact
 
     z0, roll0, _, _ = rigid_contact([0.0])
     b = ModelBuilder(3, "wheelset", gravity=(0.0, 0.0, -GRAVITY))
@@ -147,8 +147,8 @@ def test_a_wheelset_braked_to_a_stop_ends_with_the_elements_words_on_the_compile
     element's message at that stage state (the numpy path itself raises it)."""
     from core import frames
     from core.model import ModelBuilder
-    from railway.contact_geometry import rigid_contact
-    from railway.wheel_rail import WheelRailContact
+    from railway.contact.geometry import rigid_contact
+    from railway.vehicles.wheel_rail import WheelRailContact
 
     z0, roll0, _, _ = rigid_contact([0.0])
     b = ModelBuilder(3, "wheelset", gravity=(0.0, 0.0, -GRAVITY))

@@ -1,4 +1,4 @@
-"""The wheel-rail contact as a force element of the core (railway.wheel_rail) and the vehicle.
+"""The wheel-rail contact as a force element of the core (railway.vehicles.wheel_rail) and the vehicle.
 
 Oracles: the analytic linearisation of a centred wheelset on its rails (Hertz stiffness
 3N/(2 delta), Kalker's creep coefficients), the share of the weight of a symmetric vehicle,
@@ -13,11 +13,11 @@ import pytest
 
 from core.integrators import simulate
 from core.model import ModelBuilder
-from railway.contact_geometry import rigid_contact
-from railway.creep import kalker_coefficients
+from railway.contact.geometry import rigid_contact
+from railway.contact.creep import kalker_coefficients
 from railway.track import Track
-from railway.vehicle import GRAVITY, VehicleDefinition, build_vehicle
-from railway.wheel_rail import WheelRailContact, contact_history
+from railway.vehicles.vehicle import GRAVITY, VehicleDefinition, build_vehicle
+from railway.vehicles.wheel_rail import WheelRailContact, contact_history
 
 V = 20.0
 R0 = 0.46
@@ -54,8 +54,8 @@ def kind_of(model):
 # ---------------------------------------------------------------------------------------------
 def test_jacobian_against_the_analytic_linearisation():
     # conical wheels: one contact patch per wheel (the centred S1002 tread has two near-equal
-    # minima sharing the load, see railway.wheel_rail "Two patches per zone")
-    from railway.two_point import conical_wheel
+    # minima sharing the load, see railway.vehicles.wheel_rail "Two patches per zone")
+    from railway.contact.two_point import conical_wheel
 
     m = wheelset_model(wheel=conical_wheel())
     kind = kind_of(m)
@@ -179,7 +179,7 @@ def test_a_flange_that_has_climbed_ends_the_run_naming_the_wheel(method):
     46.1 mm from the taping line, on the flange tip arc above the 70 deg flank (which ends at
     -39.76 mm), more than the 5 mm criterion higher -- flange climb.  At 5 mm (short of the
     flange onset at 6.25 mm) the same run goes on."""
-    from railway.contact_geometry import rigid_contact
+    from railway.contact.geometry import rigid_contact
 
     z, _, res0, *_ = rigid_contact([-0.012])
     assert res0.y_wheel[1, 1] < -0.046  # the right wheel's flange contact of the rigid pose
@@ -327,7 +327,7 @@ def test_a_vehicle_file_with_yaw_dampers_builds_settles_and_runs(tmp_path):
 # the patch set of a wheel: a function of the geometry, not of the search's history
 # ---------------------------------------------------------------------------------------------
 def test_patch_shares_never_load_one_point_twice_and_share_only_within_a_zone():
-    from railway.wheel_rail import BLEND_GAP, patch_shares
+    from railway.vehicles.wheel_rail import BLEND_GAP, patch_shares
 
     # patches (tread, flange) primary, (tread, flange) second; y [m], gap [m], lateral semi-axis [m]
     y = np.array([[-0.0322, -0.03812, -0.03812, np.nan]])  # the tread zone's second = the flange's primary
@@ -362,10 +362,11 @@ def test_curving_forces_are_the_same_fresh_and_after_any_history():
     0.3 mm apart, two tread minima 11 mm apart with a maximum between them as the scan's second
     lowest stationary point, the tread zone finding the flange zone's contact (tolerance: the
     search's Newton tolerance on the gap, 1e-11 m, times the Hertz stiffness: 1e-6 of the force)."""
-    from railway.vehicle_scenes import creep_law_spec, curving_track
+    from railway.contact.creep import creep_law_for_runs
+    from railway.vehicles.curving import curving_track
 
     data = np.load(CURVING_STATES)
-    cl, cp = creep_law_spec("polach2000", 10.0)
+    cl, cp = creep_law_for_runs("polach2000", 10.0)
     veh = build_vehicle(VehicleDefinition.manchester(), curving_track(), s0=35.0, speed=10.0, creep_law=cl,
                         creep_params=cp, speed_control=10.0)
     m = veh.model

@@ -49,8 +49,8 @@ def main(argv=None) -> int:
         "bisection wall time [s]": bisection_cost,
         "cost ratio two-rate / bisection": two_rate_cost / bisection_cost,
         "constant-speed runs": row["constant-speed runs"],
+        "host": host_line(),
     }])
-    table.attrs["host"] = host_line()
     folder = Path(__file__).resolve().parent / "results"
     write_table(table, folder, "railway_critical_speed")
     print(host_line())

@@ -1,22 +1,17 @@
-"""The contact-mechanics example scripts (``examples/railway/``), run as a user runs them.
+"""The railway example scripts (``examples/railway/``), run as a user runs them.
 
 A user copies an example and runs it with ``python`` from whatever folder they are in; the
 script must then find its data through the package (not the working directory) and write the
 same output folder as ``mbsuite run NAME`` (tables, README, ``run.json`` saying the mode) into
-``MBSUITE_OUT``.
+``MBSUITE_OUT`` (``tests/example_run.py``).
 """
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
-from pathlib import Path
-
+import pandas as pd
 import pytest
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "railway"
+from tests.example_run import run_example, tables_written
 
 
 @pytest.mark.parametrize("script, scene, tables", [
@@ -25,16 +20,19 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "railway"
     pytest.param("contact_geometry.py", "railway-contact-geometry",
                  ("contact_geometry", "excerpt", "summary", "equivalent_conicity", "transitions"),
                  marks=pytest.mark.slow),
+    pytest.param("vehicle_curving.py", "railway-curving", ("curving_quasi_static", "lateral_equilibrium", "wheel_events"),
+                 marks=pytest.mark.slow),
 ])
-def test_contact_example_runs_by_hand_from_any_folder(tmp_path, script, scene, tables):
-    env = os.environ | {"MBSUITE_MODE": "fast", "MBSUITE_OUT": str(tmp_path / "out"), "MBSUITE_WORKERS": "1",
-                        "MPLBACKEND": "Agg"}
-    done = subprocess.run([sys.executable, str(EXAMPLES / script)], cwd=tmp_path, env=env,
-                          capture_output=True, text=True, timeout=600)
-    assert done.returncode == 0, done.stderr
-    folder = tmp_path / "out" / scene
-    for stem in tables:
-        assert (folder / f"{stem}.csv").is_file() and (folder / f"{stem}.md").is_file(), stem
+def test_railway_example_runs_by_hand_from_any_folder(tmp_path, script, scene, tables):
+    folder = run_example(f"railway/{script}", scene, tmp_path)
+    assert tables_written(folder, tables) == []
     assert (folder / "README.md").is_file()
-    run = json.loads((folder / "run.json").read_text(encoding="utf-8"))
-    assert run["mode"] == "fast" and run["scene"] == scene and run["status"] == "ok"
+
+
+def test_the_flying_wheelset_example_reproduces_klingel_by_hand(tmp_path):
+    """Run by hand from another folder, the example gives the scene's wavelength check: within
+    1 % of Klingel's with the nominal cone (tests/railway/test_vehicle_scenes.py's tolerance)."""
+    folder = run_example("railway/flying_wheelset.py", "railway-flying-wheelset", tmp_path)
+    assert tables_written(folder, ("cone_kinematic_wavelength", "s1002_limit_cycle")) == []
+    row = pd.read_csv(folder / "cone_kinematic_wavelength.csv").iloc[0]
+    assert abs(row["difference cone [-]"]) < 0.01

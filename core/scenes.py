@@ -546,10 +546,14 @@ class SceneRun:
         return df
 
     def figure(self, stem: str, fig: Figure) -> Figure:
-        """Keep ``fig`` as figure ``<stem>.png``; returns it.  Run by hand, the figure is also
-        queued for display (:func:`figures_to_show`: sphinx-gallery's scraper in ``docs/conf.py``)."""
+        """Keep ``fig`` as figure ``<stem>.png``; returns it.  Run by hand with the environment
+        variable ``MBSUITE_SHOW_FIGURES`` set (the documentation's build sets it), the figure is
+        also queued for display (:func:`figures_to_show`: sphinx-gallery's scraper in
+        ``docs/_ext/scene_figures.py``)."""
+        import os
+
         self.result.figures[stem] = fig
-        if self._collected is None:
+        if self._collected is None and os.environ.get("MBSUITE_SHOW_FIGURES"):
             _FIGURES_TO_SHOW.append(fig)
         return fig
 

@@ -20,6 +20,8 @@ os.environ["MBSUITE_MODE"] = "fast"
 # ... and write their scene folders below MBSUITE_OUT; sphinx-gallery runs each script in its own
 # folder, so without this the tables and figures would land in examples/<domain>/out/.
 os.environ["MBSUITE_OUT"] = str(ROOT / "docs" / "_build" / "gallery-out")
+# ... and queue the figures they hand to their scene for the scraper (docs/_ext/scene_figures.py)
+os.environ["MBSUITE_SHOW_FIGURES"] = "1"
 os.environ.setdefault("MPLBACKEND", "Agg")
 
 import core  # noqa: E402

@@ -119,3 +119,30 @@ def test_simulate_stops_where_stop_when_says(tmp_path):
     assert 40 < k < 70  # a quarter of the small-amplitude period 2.006 s is 0.50 s: output 51
     np.testing.assert_allclose(res.q, full.q[:k], rtol=0, atol=1e-12)
     assert res.q[-2, 0] > 0 >= res.q[-1, 0]
+
+
+def test_figures_are_queued_for_the_gallery_only_when_asked(tmp_path, monkeypatch):
+    """Run by hand, a script's figures go to the documentation's scraper queue only with
+    MBSUITE_SHOW_FIGURES set (so repeated runs in a session keep no figures alive), never under
+    the runner."""
+    import runpy
+
+    from matplotlib.figure import Figure
+
+    from core.scenes import figures_to_show
+
+    script = tmp_path / "fig.py"
+    script.write_text("from matplotlib.figure import Figure\nfrom core.scenes import scene_run\n"
+                      "scene = scene_run('fig-script')\nscene.figure('f', Figure())\nscene.done()\n")
+    monkeypatch.setenv("MBSUITE_OUT", str(tmp_path / "out"))
+    monkeypatch.setenv("MBSUITE_WORKERS", "1")
+    figures_to_show()
+    monkeypatch.delenv("MBSUITE_SHOW_FIGURES", raising=False)
+    runpy.run_path(str(script), run_name="__main__")
+    assert figures_to_show() == []
+    monkeypatch.setenv("MBSUITE_SHOW_FIGURES", "1")
+    runpy.run_path(str(script), run_name="__main__")
+    queued = figures_to_show()
+    assert len(queued) == 1 and isinstance(queued[0], Figure) and figures_to_show() == []
+    run_scene(example_scene("fig-script", script, "figure", ""), tmp_path / "runner")
+    assert figures_to_show() == []

@@ -462,6 +462,25 @@ def example_scene(name: str, script: str | Path, title: str, description: str, f
     return Scene(name, title, description, run, full_adds=full_adds)
 
 
+def _env_workers() -> int:
+    """Processes for the sweeps of a script run by hand: ``MBSUITE_WORKERS`` (default: every core)."""
+    import os
+
+    text = os.environ.get("MBSUITE_WORKERS", "").strip()
+    if not text:
+        return os.cpu_count() or 1
+    try:
+        workers = int(text)
+    except ValueError:
+        workers = 0
+    if workers < 1:
+        from .errors import InputError
+
+        raise InputError(f"environment variable MBSUITE_WORKERS={text!r}: give a number of processes >= 1 "
+                         "(1 runs the sweeps serially in this process)")
+    return workers
+
+
 class SceneRun:
     """The run of an example script: what the script may use, and where its results go.
 
@@ -531,9 +550,8 @@ class SceneRun:
             return self.ctx.executor
         if self._own_pool is None:
             import concurrent.futures
-            import os
 
-            workers = int(os.environ.get("MBSUITE_WORKERS", os.cpu_count() or 1))
+            workers = _env_workers()
             if workers <= 1:
                 return None
             self._own_pool = concurrent.futures.ProcessPoolExecutor(max_workers=workers)
@@ -575,10 +593,7 @@ class SceneRun:
         scene = all_scenes(on_error=lambda plugin, exc: None).get(self.name)
         if scene is None:
             scene = Scene(self.name, self.name, "", lambda ctx: self.result)
-        import os
-
-        record = RunRecord(scene=self.name, mode=self.mode, workers=int(os.environ.get("MBSUITE_WORKERS", os.cpu_count() or 1)),
-                           started=RunRecord.utc_now())
+        record = RunRecord(scene=self.name, mode=self.mode, workers=_env_workers(), started=RunRecord.utc_now())
         _write_output(scene, self.result, self.out_dir, record, self._start)
         print(f"{self.name}: {len(self.result.tables)} table(s), {len(self.result.figures)} figure(s) written to "
               f"{self.out_dir} (mode {self.mode}, {record.wall_time_s:.1f} s)")

@@ -220,6 +220,10 @@ def nonlinear_critical_speed(case):
     """
     import time
 
+    from core.inputs import check_keywords
+
+    check_keywords(case, ("law", "V0", "V1", "rate", "two_rate", "bisect", "stop_quiet"),
+                   where="nonlinear_critical_speed case")
     law = case["law"]
     V0, V1, rate = case.get("V0", 90.0), case.get("V1", 40.0), case.get("rate", 2.0)
     start = time.perf_counter()
@@ -237,6 +241,7 @@ def nonlinear_critical_speed(case):
                           if hunting.all() else f"no limit cycle at {V0:g} m/s")
         return dict(row=row, curve=(Vt, amp, res.status))
     V_nc = np.nan
+    notes = []
     if case.get("two_rate", True):
         start = time.perf_counter()
         speeds = []
@@ -247,8 +252,14 @@ def nonlinear_critical_speed(case):
                 r2, V2 = continue_run_down(law, res, veh, V0, rate, V_start, V_f, rate / slow, stop_quiet=quiet)
                 V_s = (hunting_threshold_speed(V2, hunting_envelope(r2, veh, V2[0], rate / slow)[1])
                        if r2.success else np.nan)
+                if not r2.success:  # a failed run says why, and no speed is extrapolated from it
+                    notes.append(f"run-down at {rate / slow:g} m/s2 from {V_start:.2f} m/s failed: {r2.message}")
+                    break
                 if np.isfinite(V_s) or V_start >= V0 - 1.0:
                     break
+            if r2.success and not np.isfinite(V_s):
+                notes.append(f"run-down at {rate / slow:g} m/s2 from {V_start:.2f} m/s: no threshold speed (not "
+                             f"hunting at its start, or hunting to its end)")
             row[f"run-down estimate at {rate / slow:g} m/s2 [m/s]"] = V_s
             speeds.append(V_s)
         V_nc = zero_rate_speed((rate / 2.0, rate / 4.0), speeds)
@@ -258,25 +269,36 @@ def nonlinear_critical_speed(case):
         start = time.perf_counter()
         V_lo, V_hi = V_f - 1.0, min(V_f + 4.0, V0 - 1.0)
         n_runs = 0
-        while not (top_ok := hunting_persists(law, res, veh, V_hi, V0, rate)[0]) and V_hi < V0 - 1.0:
+        failed = []  # a constant-speed run that fails decides nothing: the bisection stops there
+
+        def persists(V):
+            ok, r = hunting_persists(law, res, veh, V, V0, rate)
+            if not r.success:
+                failed.append(f"constant-speed run at {V:.3f} m/s failed: {r.message}")
+            return ok
+
+        while not (top_ok := persists(V_hi)) and not failed and V_hi < V0 - 1.0:
             V_lo, V_hi = V_hi, min(V_hi + 4.0, V0 - 1.0)
             n_runs += 1
         n_runs += 1
-        while top_ok and V_hi - V_lo > 0.1:
+        while top_ok and not failed and V_hi - V_lo > 0.1:
             Vm = 0.5 * (V_hi + V_lo)
-            ok, _ = hunting_persists(law, res, veh, Vm, V0, rate)
+            ok = persists(Vm)
             V_hi, V_lo = (Vm, V_lo) if ok else (V_hi, Vm)
             n_runs += 1
-        V_b = 0.5 * (V_hi + V_lo) if top_ok else np.nan
+        V_b = 0.5 * (V_hi + V_lo) if top_ok and not failed else np.nan
+        notes += failed
         row["bisected critical speed [m/s]"] = V_b
-        row["bracket [m/s]"] = (f"{V_lo:.3f} .. {V_hi:.3f}" if top_ok
-                                else f"no persisting limit cycle below {V0 - 1.0:g} m/s")
+        row["bracket [m/s]"] = ("bisection stopped by a failed run" if failed else f"{V_lo:.3f} .. {V_hi:.3f}"
+                                if top_ok else f"no persisting limit cycle below {V0 - 1.0:g} m/s")
         row["constant-speed runs"] = n_runs
         row["bisection wall time [s]"] = time.perf_counter() - start
         if np.isfinite(V_nc):
             row["two-rate minus bisected [m/s]"] = V_nc - V_b
         V_nc = V_b
     row["nonlinear critical speed [m/s]"] = V_nc
+    if notes:
+        row["outcome"] = "; ".join(notes)
     if np.isfinite(V_nc):
         row["amplitude at 1.1 V_nc [m]"] = float(np.interp(1.1 * V_nc, Vt[::-1], amp[::-1]))
     return dict(row=row, curve=(Vt, amp, res.status))

@@ -139,6 +139,9 @@ def curving_case(case):
     from .vehicle import GRAVITY, VehicleDefinition
     from .wheel_rail import contact_history
 
+    from core.inputs import check_keywords
+
+    check_keywords(case, ("law", "speed", "T", "vehicle_file"), where="curving_case")
     law, V = case["law"], float(case["speed"])
     vehicle_file = case.get("vehicle_file")
     D = VehicleDefinition.from_toml(vehicle_file) if vehicle_file else VehicleDefinition.manchester()

@@ -60,6 +60,9 @@ def irregular_track_case(case):
     from .vehicle import GRAVITY, VehicleDefinition, build_vehicle
     from .wheel_rail import contact_history
 
+    from core.inputs import check_keywords
+
+    check_keywords(case, ("speed", "length", "law", "seed"), where="irregular_track_case")
     V, length, law = case["speed"], case["length"], case.get("law", "polach2000")
     D = VehicleDefinition.manchester()
     irr = irregularities(length + 60.0, seed=case.get("seed", 1))

@@ -67,7 +67,7 @@ def test_a_missing_script_names_the_path(tmp_path):
 
 
 def _run_by_hand(path, cwd, **env):
-    environment = dict(os.environ, MPLBACKEND="Agg", MBSUITE_WORKERS="1", **env)
+    environment = {**os.environ, "MPLBACKEND": "Agg", "MBSUITE_WORKERS": "1", **env}
     environment["PYTHONPATH"] = os.pathsep.join([str(repo_root()), environment.get("PYTHONPATH", "")])
     return subprocess.run([sys.executable, str(path)], cwd=cwd, env=environment, capture_output=True, text=True,
                           timeout=600)
@@ -146,3 +146,9 @@ def test_figures_are_queued_for_the_gallery_only_when_asked(tmp_path, monkeypatc
     assert len(queued) == 1 and isinstance(queued[0], Figure) and figures_to_show() == []
     run_scene(example_scene("fig-script", script, "figure", ""), tmp_path / "runner")
     assert figures_to_show() == []
+
+
+def test_a_bad_worker_count_for_a_script_is_named(tmp_path):
+    proc = _run_by_hand(_script(tmp_path), tmp_path, MBSUITE_MODE="fast", MBSUITE_WORKERS="two")
+    # the script runs no sweep: the count is read when the run record is written
+    assert proc.returncode != 0 and "MBSUITE_WORKERS='two'" in proc.stderr

@@ -142,3 +142,20 @@ def test_the_threshold_speed_and_its_extrapolation_to_zero_rate():
     assert zero_rate_speed((1.0, 0.5), (V_nc - c * 1.0, V_nc - c * 0.5)) == pytest.approx(V_nc, abs=1e-12)
     assert zero_rate_speed((2.0, 1.0, 0.5), (55.4, 56.79, 57.755)) == pytest.approx(58.72, abs=1e-9)
     assert np.isnan(zero_rate_speed((1.0, 0.5), (np.nan, 57.0)))
+
+
+@pytest.mark.parametrize("function, case, closest", [
+    ("railway.vehicles.critical_speed:nonlinear_critical_speed", dict(law="polach2000", bisection=True), "bisect"),
+    ("railway.vehicles.curving:curving_case", dict(law="polach2000", speed=10.0, vehicle="x.toml"), "vehicle_file"),
+    ("railway.vehicles.ride:irregular_track_case", dict(speed=20.0, length=120.0, seeds=2), "seed"),
+])
+def test_a_misspelt_case_key_is_named_before_any_run(function, case, closest):
+    """The case dicts of the vehicle studies refuse an unknown key, naming the closest accepted one,
+    instead of running with the default it would silently get."""
+    import importlib
+
+    from core.inputs import UnknownOptionError
+
+    module, name = function.split(":")
+    with pytest.raises(UnknownOptionError, match=f"did you mean {closest!r}"):
+        getattr(importlib.import_module(module), name)(case)

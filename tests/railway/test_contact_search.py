@@ -317,3 +317,63 @@ def test_saddles_of_the_gap_are_not_contacts(setup):
     res = cs.search(r, A, [10.0], warm=False)
     assert 0.5 * (res.k_wheel_lateral + res.k_rail_lateral)[0, 0] > 0.0
     assert -1e-12 <= g_brute - res.gap[0, 0] <= 5e-9
+
+
+# A pose recorded in the run-down of the Manchester coach (Polach 2000, 90 -> 40 m/s at 2 m/s²,
+# t = 16.0 s, V = 58 m/s): wheelset 2, left tread, the tracked point of the last accepted step as
+# the seed.  At the rail arc length 1 238 m one ulp is 2.3e-13 m, so the merit |W h|^2 of the
+# Newton iteration (h3, h4 weighted by 1 000) bottoms out near 5e-20; the second pass's step was
+# still 1.3e-11 (above the 1e-11 tolerance) and every later pass was refused by the backtracking,
+# which reported this converged contact as lost: the wheel's normal force fell by tens of kN for
+# a 0.1 µm change of the pose, and the integrator ground through 10 µs steps.
+_RECORDED_POSE = dict(
+    r=[1238.3758723897738, 8.411133121367218e-05, 0.4597615885624411],
+    A=[[0.9999998711220044, -0.0005076967348335252, 1.4982186875324315e-09],
+       [0.0005076967350374221, 0.9999998707203928, -2.951010694080152e-06],
+       [-0.0, 2.9510110744005444e-06, 0.9999999995983885]],
+    s=1238.3758723897738,
+    x0=[1.2852708561512322e-05, 0.002862390503951154, 1238.3754960744734, -9.465675427045359e-05],
+    problem=4)
+
+
+@pytest.fixture(scope="module")
+def coach_search():
+    from railway.vehicles.vehicle import VehicleDefinition, build_vehicle
+
+    track = Track.straight(2350.0)
+    veh = build_vehicle(VehicleDefinition.manchester(), track, s0=30.0, speed=58.0)
+    return veh.contact_kind.sets[0].cs
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_newton_converges_at_the_round_off_floor_far_along_the_track(coach_search, compiled):
+    from railway.contact.search.kernels import merit_floor
+
+    if compiled:
+        pytest.importorskip("numba")
+    cs = coach_search
+    kernel = cs._kernel
+    if not compiled:
+        cs._kernel = None
+    try:
+        p = _RECORDED_POSE
+        n = cs.n_wheelsets
+        r = np.tile(p["r"], (n, 1))
+        A = np.tile(np.array(p["A"]), (n, 1, 1))
+        s = np.full(n, p["s"])
+        res, x, g = cs.solve_pairs(np.array([p["x0"]]), np.array([p["problem"]]), r, A, s)
+        # the contact is found: a penetrating minimum of the gap next to the seed
+        assert res.valid.ravel()[p["problem"]]
+        assert -1e-4 < g[0] < 0.0
+        assert np.max(np.abs(x[0] - p["x0"])[[1, 3]]) < 2e-6
+        # and it is the converged one: a fresh search from the global scan finds the same point
+        fresh = cs.search(r, A, s, warm=False)
+        i, j = divmod(p["problem"], 2)
+        assert fresh.y_wheel.reshape(-1, 2)[i, j] == pytest.approx(x[0, 1], abs=1e-9)
+        assert fresh.gap.reshape(-1, 2)[i, j] == pytest.approx(g[0], abs=1e-12)
+    finally:
+        cs._kernel = kernel
+    # the floor is 16 ulps of the largest coordinate: at 1 300 m about 4e-17, near the origin 3e-23
+    e2 = (16 * np.finfo(float).eps) ** 2
+    assert merit_floor(1.0, 1.0, 1e3, 1e3, 1300.0) == pytest.approx(e2 * (2 + 2e6 * 1301**2))
+    assert merit_floor(1.0, 1.0, 1e3, 1e3, 0.0) == pytest.approx(e2 * (2 + 2e6))

@@ -28,7 +28,31 @@ except ImportError:  # pragma: no cover - exercised only without numba
     numba = None
     HAVE_NUMBA = False
 
-__all__ = ["HAVE_NUMBA", "newton_kernel", "scan_kernel", "reduced_min_kernel"]
+__all__ = ["HAVE_NUMBA", "MERIT_FLOOR_MIN", "MERIT_ROUNDOFF_ULPS", "merit_floor", "newton_kernel", "scan_kernel",
+           "reduced_min_kernel"]
+
+#: The Newton merit ``phi = |W h|^2`` of the contact conditions cannot fall below the round-off
+#: of its terms: h3 and h4 are differences of global positions, so they carry a few ulps of the
+#: largest coordinate (the rail arc length s, the wheelset's distance from the origin), and h1,
+#: h2 a few ulps of 1.  At s = 1 300 m one ulp is 2.3e-13 m and, weighted by 1 000, the floor of
+#: phi is about 5e-20: a Newton step that lands there cannot lower phi and, without this floor,
+#: was refused by the backtracking until the iteration limit, so that an already converged
+#: contact was reported as lost (a 37 kN force step for a 0.1 um change of the pose, and
+#: integrators grinding at 10 us steps near centred running; issue 22).  A pass whose merit is
+#: below ``merit_floor`` counts as converged.
+MERIT_ROUNDOFF_ULPS = 16.0
+#: lower bound of the merit floor (the fixed threshold the iteration used before the round-off floor)
+MERIT_FLOOR_MIN = 1e-26
+_EPS = float(np.finfo(float).eps)
+
+
+def merit_floor(w0, w1, w2, w3, size):
+    r"""Round-off floor of the Newton merit: :math:`(k\varepsilon)^2\,[w_1^2 + w_2^2 +
+    (w_3^2 + w_4^2)(1 + L)^2]`, at least :data:`MERIT_FLOOR_MIN`, with k =
+    :data:`MERIT_ROUNDOFF_ULPS` ulps, the merit weights w and the largest coordinate magnitude
+    ``size`` [m] (scalars or numpy arrays)."""
+    e = MERIT_ROUNDOFF_ULPS * _EPS
+    return np.maximum(MERIT_FLOOR_MIN, e * e * (w0 * w0 + w1 * w1 + (w2 * w2 + w3 * w3) * (1.0 + size) ** 2))
 
 
 # The kernels are module-level functions (inside this ``if``), not closures: numba's on-disk
@@ -271,6 +295,11 @@ if HAVE_NUMBA:
             cvd = False
             it = 0
             rp, Ap = rws[pi], A[pi]  # views made once per problem, not per pass
+            size = max(abs(rp[0]), abs(rp[1]), abs(rp[2]), abs(x[2]))
+            ef = MERIT_ROUNDOFF_ULPS * _EPS
+            floor = ef * ef * (wts[0] ** 2 + wts[1] ** 2 + (wts[2] ** 2 + wts[3] ** 2) * (1.0 + size) ** 2)
+            if floor < MERIT_FLOOR_MIN:
+                floor = MERIT_FLOOR_MIN
             for it in range(1, max_iter + 1):
                 evaluate(x, sig[pi], r0[pi], L[pi], ow[pi], orr[pi], Y0[pi], Z0[pi], ca[pi],
                          sa[pi], rp, Ap, b_inner, b_breaks, b_stack, f_inner, f_breaks,
@@ -291,9 +320,9 @@ if HAVE_NUMBA:
                 phi = 0.0
                 for k in range(4):
                     phi += (h[k] * wts[k]) ** 2
-                accept = (phi <= phi_acc * (1.0 - 1e-4 * alpha)) or (phi < 1e-26) or (phi_acc == np.inf)
+                accept = (phi <= phi_acc * (1.0 - 1e-4 * alpha)) or (phi < floor) or (phi_acc == np.inf)
                 done = False
-                if accept and (big < tol_lin or phi < 1e-26):
+                if accept and (big < tol_lin or phi < floor):
                     cvd = True
                     done = True
                 else:

@@ -9,7 +9,9 @@ normal n_r, the contact points satisfy::
 for x = (theta, y, s, u); the gap is g = d . n_r.  Newton's method with the analytic Jacobian
 (:meth:`NewtonSolve._residual_jac`) or forward differences (5 P residuals in one vectorised
 pass); the P 4x4 systems in one batched ``np.linalg.solve``.  A step that does not reduce the
-merit ``|W h|^2`` is retried from the last accepted point with a quarter of its length; steps are
+merit ``|W h|^2`` is retried from the last accepted point with a quarter of its length, and a pass
+whose merit is at its round-off floor (:func:`railway.contact.search.kernels.merit_floor`: a few
+ulps of the largest coordinate, the rail arc length on a long track) has converged; steps are
 limited and the parameters kept inside their zones.  A step below ``tol_linear`` is applied
 without a further pass, the outputs linearised about the evaluated point (error O(step^2)).  A
 converged stationary point is a contact only where the gap has a minimum across the profiles
@@ -26,6 +28,8 @@ paper here).
 from __future__ import annotations
 
 import numpy as np
+
+from .kernels import merit_floor
 
 __all__ = ["NewtonSolve"]
 
@@ -232,9 +236,10 @@ class NewtonSolve:
             # backtracking across passes on the merit |W h|^2: a step that does not reduce it
             # is retried from the last accepted point with a quarter of its length
             phi = np.sum((H0 * wts) ** 2, axis=1)
+            floor = merit_floor(*wts, np.maximum(np.max(np.abs(ra), axis=1), np.abs(xa[:, 2])))
             pa, al = phi_acc[sl], alpha[sl]
-            accept = (phi <= pa * (1.0 - 1e-4 * al)) | (phi < 1e-26) | ~np.isfinite(pa)
-            cv = accept & ((np.max(np.abs(dx), axis=1) < tol_lin) | (phi < 1e-26))
+            accept = (phi <= pa * (1.0 - 1e-4 * al)) | (phi < floor) | ~np.isfinite(pa)
+            cv = accept & ((np.max(np.abs(dx), axis=1) < tol_lin) | (phi < floor))
             dx_fin[sl] = np.where(cv[:, None], dx, 0.0)
             al = np.where(accept, 1.0, 0.25 * al)
             xacc = np.where(accept[:, None], xa, x_acc[sl])

@@ -31,7 +31,7 @@ import concurrent.futures
 from collections.abc import Callable, Iterable
 from typing import TypeVar
 
-__all__ = ["executor_workers", "run_sweep"]
+__all__ = ["executor_workers", "run_sweep", "simulate_case"]
 
 C = TypeVar("C")
 R = TypeVar("R")
@@ -132,3 +132,28 @@ def executor_workers(executor: concurrent.futures.Executor | None) -> int | None
     if isinstance(executor, (concurrent.futures.ProcessPoolExecutor, concurrent.futures.ThreadPoolExecutor)):
         return int(executor._max_workers)  # the standard library keeps it only here
     return None
+
+
+def simulate_case(case: dict):
+    """One run of a sweep of simulations, for :func:`run_sweep`: ``case = dict(system=factory,
+    t_span=(t0, t1), method=..., **simulate_options)``.
+
+    ``factory()`` builds the system in the process that runs the case (a module-level function,
+    a class or a :func:`functools.partial` of one, so that the case pickles; a built model need
+    not); the rest goes to :func:`core.integrators.simulate` unchanged.  Returns its
+    :class:`core.results.SimulationResult`, which pickles back.
+
+    Examples
+    --------
+    >>> import functools
+    >>> from core import models
+    >>> cases = [dict(system=functools.partial(models.n_link_chain, 2), t_span=(0.0, 0.1), method=m,
+    ...               n_output=3) for m in ("radau-ggl", "dop853-projection")]
+    >>> [r.status for r in run_sweep(simulate_case, cases)]
+    ['finished', 'finished']
+    """
+    from .integrators import simulate
+
+    opts = dict(case)
+    system = opts.pop("system")()
+    return simulate(system, opts.pop("t_span"), opts.pop("method"), **opts)

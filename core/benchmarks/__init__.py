@@ -22,6 +22,7 @@ from .harness import (
     COLUMNS,
     COUNTERS,
     DETERMINISTIC_COLUMNS,
+    MAX_REPEAT_TIME,
     available_methods,
     run_problem_set,
     run_problems,
@@ -57,6 +58,7 @@ from .testset import AndrewsSqueezer, CarAxis
 
 __all__ = [
     "COLUMNS",
+    "MAX_REPEAT_TIME",
     "COUNTERS",
     "DETERMINISTIC_COLUMNS",
     "GRID_NAMES",

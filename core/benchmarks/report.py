@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 
 from ..results import FINISHED_STATUSES, STATUS_WARNED
-from .harness import COLUMNS, COUNTERS, SETTING_RTOL, SETTING_STEP
+from .harness import COLUMNS, COUNTERS, MAX_REPEAT_TIME, SETTING_RTOL, SETTING_STEP
 from .problems import PROBLEMS
 
 __all__ = ["REPORT_COLUMNS", "fastest_to_tolerance", "report_table", "work_precision_figure",
@@ -283,8 +283,8 @@ def work_precision_notes(problems: Sequence[str], grid: str, workers: int | None
     """
     who = f"{workers} worker process(es)" if workers is not None else "the workers of a distributed executor"
     lines = [(f"Grid `{grid}`; {who} (solves run concurrently when > 1, which may "
-              "inflate wall times slightly). Wall time = median over repeats of the time inside the "
-              "integrator steps. Fixed-step methods: Newton tolerance rtol = atol = 1e-10; "
+              "inflate wall times slightly). Wall time = median over the repeated solves of the time inside the "
+              f"integrator steps (a case stops repeating once its solves took {MAX_REPEAT_TIME:g} s in all). Fixed-step methods: Newton tolerance rtol = atol = 1e-10; "
               "error-controlled methods: atol = rtol."),
              "", "| problem | error measure | reference |", "|---|---|---|"]
     for name in problems:

@@ -30,8 +30,8 @@ import pandas as pd
 
 from core import plot
 from core.benchmarks.testset import AndrewsSqueezer
-from core.integrators import simulate
 from core.scenes import scene_run
+from core.sweep import run_sweep, simulate_case
 
 scene = scene_run("andrews")
 
@@ -46,9 +46,10 @@ settings = {
     "radau-projection rtol=1e-10": ("radau-projection", dict(rtol=1e-10, atol=1e-12)),
     "generalized-alpha h=1e-6": ("generalized-alpha", dict(h=1e-5 if scene.fast else 1e-6)),  # fast: 1e-5
 }
-results = {}
-for label, (method, options) in scene.progress(settings.items(), desc="andrews"):
-    results[label] = simulate(squeezer, (0.0, 0.03), method, n_output=301, **options)
+# The three runs go through the scene's sweep executor (every local core by default).
+cases = [dict(system=AndrewsSqueezer, t_span=(0.0, 0.03), method=method, n_output=301, **options)
+         for method, options in settings.values()]
+results = dict(zip(settings, run_sweep(simulate_case, cases, executor=scene.executor)))
 
 # %%
 # Tables

@@ -20,13 +20,15 @@ This script is the scene ``n-link-chain``: ``mbsuite run n-link-chain`` runs thi
 # %%
 # Model
 # -----
+import functools
+
 import numpy as np
 import pandas as pd
 
 from core import models, plot
 from core.benchmarks.references import n_link_chain_reference
-from core.integrators import simulate
 from core.scenes import scene_run
+from core.sweep import run_sweep, simulate_case
 
 scene = scene_run("n-link-chain")
 
@@ -42,10 +44,12 @@ settings = {
     "generalized-alpha h=1e-4": ("generalized-alpha", dict(h=1e-4)),
     "dop853-projection rtol=1e-8": ("dop853-projection", dict(rtol=1e-8, atol=1e-10)),
 }
-runs = [(kind, label, method, options) for kind in chains for label, (method, options) in settings.items()]
-results = {}
-for kind, label, method, options in scene.progress(runs, desc="n-link chain"):
-    results[kind, label] = simulate(chains[kind], (0.0, 1.0), method, n_output=101, **options)
+# The six runs go through the scene's sweep executor (every local core by default); each builds
+# its chain in the process that runs it.
+runs = [(kind, label) for kind in chains for label in settings]
+cases = [dict(system=functools.partial(models.n_link_chain, n, planar=kind == "planar"), t_span=(0.0, 1.0),
+              method=settings[label][0], n_output=101, **settings[label][1]) for kind, label in runs]
+results = dict(zip(runs, run_sweep(simulate_case, cases, executor=scene.executor)))
 
 # %%
 # Tables

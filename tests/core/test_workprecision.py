@@ -238,3 +238,14 @@ def test_a04_reference_agrees_with_the_numpy_path_and_conserves_energy():
     assert res.status == "finished"
     assert np.linalg.norm(refs.iftomm_a04_p2(system, res.q[-1]) - ref) < 1e-8
     assert np.max(np.abs(res.energy - res.energy[0])) < 1e-8 * 5 * 9.81
+
+
+def test_a_case_stops_repeating_at_the_time_budget():
+    # a budget below any solve's time: one solve per case; a budget far above: all the repeats
+    kw = dict(methods=["dop853-projection"], settings={"rtol": [1e-6]}, repeats=3)
+    one = wp.run_work_precision(CHAIN, max_repeat_time=1e-9, **kw)
+    three = wp.run_work_precision(CHAIN, max_repeat_time=1e3, **kw)
+    assert (one["n repeats"] == 1).all() and (three["n repeats"] == 3).all()
+    # the default budget is the module's, and a solve of this size (milliseconds) repeats under it
+    assert wp.MAX_REPEAT_TIME == 0.5
+    assert (wp.run_work_precision(CHAIN, **kw)["n repeats"] == 3).all()

@@ -40,3 +40,5 @@ $(STAMP): pyproject.toml | $(BIN)/python
 
 clean:
 	rm -rf $(OUT) .pytest_cache .hypothesis build dist docs/_build docs/generated docs/auto_examples
+	# numba's on-disk cache: a cached kernel is not recompiled when a kernel it calls changes
+	find core railway biomech coaster tests examples -name '*.nb[ic]' -delete

@@ -1131,11 +1131,7 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
     quarter of the larger change: a smooth peak exceeds its best sample by at most an eighth),
     the two adjacent steps are sampled at ``peak_samples`` interpolated states each (the error of
     a sampled peak falls with the square of the sample spacing); ``df.attrs["peaks"]`` holds per
-    wheel and column ``(kind, value, time)``.  With the run's recorded search states the
-    refinement waits for the last row and takes the candidates in the order of their bounds,
-    skipping each whose bound no longer exceeds the extreme found by then: on a 4 s curving run
-    (20 m/s, Polach 2000, 4 455 steps) the same 32 peaks and times as refining while the rows pass,
-    in 4.9 instead of 7.4 s.
+    wheel and column ``(kind, value, time)``.
 
     Returns
     -------
@@ -1242,24 +1238,22 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
     sign = {"max": lambda x: x, "min": lambda x: -x, "absmax": np.abs}
     refine_peaks = at == "steps" and peak_samples > 0
     best = {pc: (np.full(len(labels), -np.inf), np.full(len(labels), np.nan)) for pc in PEAK_COLUMNS}
-    recent: list[tuple] = []  # the wheel outputs of the last three rows, with the signed peak columns
+    recent: list[tuple] = []  # the wheel outputs of the last three rows, with their signed peak columns
 
-    def peak_candidates(i):  # row i - 1 a local extreme of some (column, wheel)? [(pc, wheels, bounds)]
-        found = []
+    def consider_peaks(i):  # row i - 1 a local extreme of some (column, wheel)? refine over (T[i-2], T[i])
+        b = recent[-2][0]
+        todo = []
         for pc in PEAK_COLUMNS:
             xa, xb, xc = (r_[1][pc] for r_ in recent[-3:])
             with np.errstate(invalid="ignore"):
                 # a smooth peak exceeds its best sample by at most 1/8 of the larger change to
                 # the neighbours (a parabola sampled with the peak midway between samples): 1/4 kept
                 room = 0.25 * np.nan_to_num(np.maximum(np.abs(xb - xa), np.abs(xb - xc)), nan=0.0, posinf=0.0)
-                bound = xb + room
-                cand = (xb >= xa) & (xb >= xc) & np.isfinite(xb) & (bound > best[pc][0])
+                cand = (xb >= xa) & (xb >= xc) & np.isfinite(xb) & (xb + room > best[pc][0])
             if cand.any():
-                w_ = np.flatnonzero(cand)
-                found.append((pc, w_, bound[w_]))
-        return found
-
-    def refine(i, todo, b):  # sample the steps (T[i-2], T[i-1]) and (T[i-1], T[i]) for the candidates todo
+                todo.append((pc, np.flatnonzero(cand)))
+        if not todo:
+            return
         samples = []
         for k in (i - 1, i):
             for j in range(1, peak_samples):
@@ -1273,14 +1267,6 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
                 j = int(np.argmax(vals))
                 if vals[j] > best[pc][0][w_]:
                     best[pc][0][w_], best[pc][1][w_] = vals[j], samples[j][0]
-
-    # With the run's recorded search states the state at any row is known without carrying it, so
-    # the refinement waits for the end: the candidates in the order of their bounds, each refined
-    # only while its bound exceeds the extreme found so far (every sample and every refinement
-    # before it).  Carried states are only at hand while the rows pass: refined as they come.
-    deferred: list[tuple[float, int, tuple, int]] = []  # (bound, row, column, wheel)
-    wheels_of_row: dict[int, dict] = {}
-    candidates_of_row: dict[int, dict] = {}
 
     prev_loaded = None
     try:
@@ -1303,21 +1289,13 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
             prev_loaded = loaded
             if refine_peaks:
                 signed = {pc: np.nan_to_num(sign[pc[1]](np.asarray(out["wheels"][pc[0]], float)), nan=-np.inf)
-                          for pc in PEAK_COLUMNS}
+                          for pc in PEAK_COLUMNS}  # once per row, for the best and the candidates
                 recent.append((out["wheels"], signed))
                 for pc, x in signed.items():  # every sample counts (the first, the last, a plateau)
                     better = x > best[pc][0]
                     best[pc][0][better], best[pc][1][better] = x[better], float(t)
                 if len(recent) >= 3:
-                    found = peak_candidates(i)
-                    if recorded is not None:
-                        if found:
-                            wheels_of_row[i - 1] = recent[-2][0]
-                            candidates_of_row[i] = {pc: ws_ for pc, ws_, _ in found}
-                            deferred.extend((float(bd), i, pc, int(w_)) for pc, ws_, bds in found
-                                            for w_, bd in zip(ws_, bds))
-                    elif found:
-                        refine(i, [(pc, ws_) for pc, ws_, _ in found], recent[-2][0])
+                    consider_peaks(i)
                     recent.pop(0)
             r, A, v, w = st.states(bs)
             speed = np.einsum("nk,nk->n", v, st.track.evaluate_raw(np.nan_to_num(out["wheelsets"]["s [m]"]))[3][:, :, 0])
@@ -1333,13 +1311,6 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
                 row[k] = np.repeat(np.asarray(v_), 2)
             row["speed [m/s]"] = np.repeat(speed, 2)
             rows.append(row)
-        refined: set[int] = set()
-        for bound, i, pc, w_ in sorted(deferred, key=lambda d: (-d[0], d[1])):
-            if i in refined or not bound > best[pc][0][w_]:
-                continue
-            refined.add(i)
-            carry(i, T[i], None)  # the search state the row had (recorded: a function of the row)
-            refine(i, list(candidates_of_row[i].items()), wheels_of_row[i - 1])
     finally:
         st.state = saved
     df = pd.DataFrame({k: np.concatenate([np.asarray(r_[k]) for r_ in rows]) for k in rows[0]})

@@ -152,8 +152,18 @@ def simulate_case(case: dict):
     >>> [r.status for r in run_sweep(simulate_case, cases)]
     ['finished', 'finished']
     """
+    from .errors import InputError
     from .integrators import simulate
 
+    if not isinstance(case, dict):
+        raise InputError(f"simulate_case: a case is a dict(system=..., t_span=..., method=...), got {case!r}")
+    missing = [k for k in ("system", "t_span", "method") if k not in case]
+    if missing:
+        raise InputError(f"simulate_case: the case {sorted(case)} lacks {', '.join(missing)} "
+                         "(system: a picklable factory; t_span: (t0, t1); method: an integrator name)")
+    if not callable(case["system"]):
+        raise InputError(f"simulate_case: system must be a factory that builds the system (a module-level function, "
+                         f"class or functools.partial), got {case['system']!r}")
     opts = dict(case)
     system = opts.pop("system")()
     return simulate(system, opts.pop("t_span"), opts.pop("method"), **opts)

@@ -318,6 +318,8 @@ def run_work_precision(problem: str | WorkPrecisionProblem, methods: str | Seque
         raise ValueError(f"repeats must be ≥ 1, got {repeats}")
     grid = _grid_from(prob, settings)
     max_repeat_time = MAX_REPEAT_TIME if max_repeat_time is None else float(max_repeat_time)
+    if not max_repeat_time > 0:
+        raise ValueError(f"max_repeat_time must be > 0 s, got {max_repeat_time}")
     cases = _cases(prob, methods, grid, int(repeats), max_repeat_time, prob.reference())
     rows = run_sweep(_run_case, cases, executor=executor, progress=progress)
     return _frame(prob, grid, rows)
@@ -371,6 +373,9 @@ def run_problem_set(problems: Sequence[str], grid: str, methods=None, repeats: i
     own_pool = ProcessPoolExecutor(max_workers=jobs) if executor is None and jobs > 1 else None
     executor = executor if executor is not None else own_pool
     where = f"{jobs} process(es)" if executor is None or own_pool is not None else "the given executor"
+    budget = MAX_REPEAT_TIME if max_repeat_time is None else float(max_repeat_time)
+    if not budget > 0:
+        raise ValueError(f"max_repeat_time must be > 0 s, got {max_repeat_time}")
     probs = [_resolve_problem(name) for name in problems]
     try:
         if report is not None:
@@ -382,8 +387,7 @@ def run_problem_set(problems: Sequence[str], grid: str, methods=None, repeats: i
         all_cases: list[_Case] = []
         for prob in probs:
             g = prob.grid(grid)
-            cases = _cases(prob, methods, g, repeats,
-                           MAX_REPEAT_TIME if max_repeat_time is None else float(max_repeat_time), prob.reference())
+            cases = _cases(prob, methods, g, repeats, budget, prob.reference())
             plan.append((prob, g, len(all_cases), len(cases)))
             all_cases += cases
         if report is not None:

@@ -75,3 +75,25 @@ def test_executor_workers():
         pass
 
     assert executor_workers(Elsewhere()) is None
+
+
+def test_simulate_case_runs_anywhere_and_names_what_a_case_lacks():
+    import functools
+
+    from core import models
+    from core.errors import InputError, UnknownOptionError
+    from core.sweep import simulate_case
+
+    make = functools.partial(models.n_link_chain, 2)
+    case = dict(system=make, t_span=(0.0, 0.05), method="dop853-projection", n_output=3, rtol=1e-8, atol=1e-10)
+    serial = run_sweep(simulate_case, [case])[0]
+    with concurrent.futures.ProcessPoolExecutor(max_workers=1) as ex:
+        pooled = run_sweep(simulate_case, [case], executor=ex)[0]
+    assert serial.status == pooled.status == "finished"
+    np.testing.assert_array_equal(serial.q, pooled.q)  # the same run, built in the worker
+    with pytest.raises(InputError, match="lacks t_span"):
+        simulate_case(dict(system=make, t_spn=(0.0, 0.05), method="dop853"))
+    with pytest.raises(InputError, match="system must be a factory"):
+        simulate_case(dict(system=make(), t_span=(0.0, 0.05), method="dop853"))
+    with pytest.raises(UnknownOptionError, match="rtl"):
+        simulate_case(dict(system=make, t_span=(0.0, 0.05), method="dop853", rtl=1e-6))

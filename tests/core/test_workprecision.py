@@ -249,3 +249,10 @@ def test_a_case_stops_repeating_at_the_time_budget():
     # the default budget is the module's, and a solve of this size (milliseconds) repeats under it
     assert wp.MAX_REPEAT_TIME == 0.5
     assert (wp.run_work_precision(CHAIN, **kw)["n repeats"] == 3).all()
+
+
+def test_a_non_positive_repeat_budget_is_refused():
+    with pytest.raises(ValueError, match="max_repeat_time must be > 0 s, got -1"):
+        wp.run_work_precision(CHAIN, methods=["dop853-projection"], settings={"rtol": [1e-3]}, max_repeat_time=-1)
+    with pytest.raises(ValueError, match="max_repeat_time must be > 0 s, got 0"):
+        wp.run_problem_set([CHAIN], "quick", methods=["dop853-projection"], max_repeat_time=0)

@@ -401,6 +401,39 @@ class _Set:
                              "lateral direction; the body y axis must be the axle")
 
     # ---------------------------------------------------------------------------------------
+    def batched(self, n):
+        """This element with its wheelsets repeated ``n`` times side by side: wheelset k of copy b
+        is wheelset ``b n_ws + k``, its problems ``4 (b n_ws + k) + 0..3``.  The contacts and
+        forces of every wheelset depend only on its own pose, velocities and search state (the
+        search's problems are independent: Newton per (seed, problem) pair, the lowest gap per
+        problem), so :meth:`contacts` of the copy evaluates ``n`` states of the vehicle, each with
+        its own search state, in one vectorised call (:func:`contact_history` on a recorded run).
+        Poses are passed in (:meth:`states` of this element per state); the copy shares the
+        profiles, track and tables and has its own search state.  Cached per ``n``."""
+        import copy
+
+        cache = self.__dict__.setdefault("_batched", {})
+        b = cache.get(n)
+        if b is None:
+            b = copy.copy(self)
+            b.__dict__.pop("_batched", None)
+            b.n_ws = n * self.n_ws
+            b.wheelset_names = list(self.wheelset_names) * n
+            b.bw = np.tile(self.bw, n)
+            b.state = None
+            cs = copy.copy(self.cs)
+            cs.__dict__.pop("_rep_cache", None)
+            cs.n_wheelsets = b.n_ws
+            cs._problems = cs._tile(b.n_ws)
+            cs._subset_cache = {}
+            cs.reset()
+            b.cs = cs
+            b.cf = copy.copy(self.cf)  # its own per-size index cache
+            if len(cache) > 4:
+                cache.clear()
+            cache[n] = b
+        return b
+
     def states(self, bs):
         """Wheelset centre, rotation, velocity and global angular velocity (with the nominal
         spin, if any), in the rail frame."""
@@ -1078,6 +1111,10 @@ def _hermite_state(model, q_a, v_a, q_b, v_b, h, s_, axle_bodies=()):
 
 #: peaks refined by :func:`contact_history` at the accepted steps: (column, kind), kind "max",
 #: "min" or "absmax" (largest magnitude)
+#: rows of a recorded run that :func:`contact_history` evaluates in one vectorised call
+#: (:meth:`_Set.batched`); a few hundred take the numpy overhead per call out of the rows
+ROW_BATCH = 256
+
 PEAK_COLUMNS = (("Q [N]", "max"), ("Q [N]", "min"), ("Y [N]", "absmax"), ("Y/Q [-]", "max"),
                 ("flange force [N]", "max"))
 
@@ -1097,7 +1134,12 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
       re-seeding schedule -- the search state the run had.  Each row is evaluated at its stored
       state with the state of the last accepted step at or before it, which is the state the run
       used for its forces there: the rows equal those of ``at="steps"`` where the times agree, and
-      do not depend on the output step.
+      do not depend on the output step.  A compiled run records that state at every accepted step
+      (:func:`core.results.search_states_at_steps`); the rows are then independent and are
+      evaluated :data:`ROW_BATCH` at a time, the wheelsets of all of them side by side in one
+      vectorised call (:meth:`_Set.batched`; the same numbers as one row at a time to round-off -- the
+      track projection's Newton iterates every wheelset until the last one converged -- at a
+      fifth of the time).
     * ``"hermite"`` (the default without recorded steps): reset at the first row, then carried from
       row to row through the accept hook at intermediate states at most ``max_step`` apart -- the
       positions interpolated by the cubic Hermite through q̇ = Z(q) v at both rows, the wheelsets'
@@ -1172,6 +1214,7 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
         seed_path = "steps"
     else:
         raise InputError(f"contact_history: at must be 'outputs' or 'steps', got {at!r}")
+    T = np.asarray(T, float)
     if locate_lift is None:
         locate_lift = at == "steps"
     kind = next(k for k in model.force_kinds if isinstance(k, WheelRailKind))
@@ -1181,15 +1224,48 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
     labels = [f"{ws} {sd}" for ws in st.wheelset_names for sd in ("left", "right")]
     crossings: dict[str, dict[float, float]] = {lab: {} for lab in labels}
 
-    def wheels_at(k, tau):  # wheel outputs at a state interpolated in the step (T[k - 1], T[k])
+    nw = 2 * st.n_ws
+
+    def evaluate(qs, vs, states):
+        """Outputs at the states (qs[b], vs[b]), each with the search state states[b], in one
+        vectorised call (:meth:`_Set.batched`): wheels (B nw,), contacts (B nw, 2), wheelsets
+        (B n_ws,), row-major."""
+        poses = [st.states(model.body_states(np.asarray(q, float), np.asarray(v, float))) for q, v in zip(qs, vs)]
+        r, A, v, w = (np.concatenate([p_[j] for p_ in poses]) for j in range(4))
+        stb = st.batched(len(qs))
+        stb.state = _State(seeds=np.concatenate([s_.seeds for s_ in states], axis=1),
+                           s_ws=np.concatenate([s_.s_ws for s_ in states]),
+                           valid=np.concatenate([s_.valid for s_ in states]))
+        res, f, s, Ans = stb.contacts(r, A, v, w)
+        out = _wheel_quantities(stb, res, f, r, Ans, s, w)
+        out["wheelsets"]["speed [m/s]"] = np.einsum(
+            "nk,nk->n", v, st.track.evaluate_raw(np.nan_to_num(s))[3][:, :, 0])
+        return out
+
+    def table_rows(ts, out):  # the rows of the long table at the times ts, from evaluate()
+        B = len(ts)
+        row = {"t [s]": np.repeat(np.asarray(ts, float), nw), "wheel": labels * B,
+               "wheelset": np.tile(np.repeat(st.wheelset_names, 2), B), "side": ["left", "right"] * (st.n_ws * B)}
+        row.update({k: np.asarray(v_) for k, v_ in out["wheels"].items()})
+        for k in ("N [N]", "Fx [N]", "Fy [N]", "xi [-]", "eta [-]", "phi [1/m]"):
+            for c, lab in enumerate(("tread", "flange")):
+                row[f"{k.split(' ')[0]}_{lab} {k.split(' ')[1]}"] = out["contacts"][k][:, c]
+        for k, v_ in out["wheelsets"].items():
+            row[k] = np.repeat(np.asarray(v_), 2)
+        return row
+
+    def interpolated(k, taus):  # states interpolated in the step (T[k - 1], T[k]) at the times taus
         t_a, t_b = float(T[k - 1]), float(T[k])
         q_a, v_a, q_b, v_b = (np.asarray(x, float) for x in (Qs[k - 1], Vs[k - 1], Qs[k], Vs[k]))
         h = t_b - t_a
-        s_ = (tau - t_a) / h
-        h00, h10, h01, h11 = 2 * s_**3 - 3 * s_**2 + 1, s_**3 - 2 * s_**2 + s_, -2 * s_**3 + 3 * s_**2, s_**3 - s_**2
-        q = model.normalize(h00 * q_a + h10 * h * model.qdot(q_a, v_a) + h01 * q_b + h11 * h * model.qdot(q_b, v_b))
-        v = (1.0 - s_) * v_a + s_ * v_b
-        return kind.contact_outputs(model.body_states(q, v), float(tau), st.name)["wheels"]
+        qd_a, qd_b = model.qdot(q_a, v_a), model.qdot(q_b, v_b)
+        qs, vs = [], []
+        for tau in taus:
+            s_ = (tau - t_a) / h
+            h00, h10, h01, h11 = 2 * s_**3 - 3 * s_**2 + 1, s_**3 - 2 * s_**2 + s_, -2 * s_**3 + 3 * s_**2, s_**3 - s_**2
+            qs.append(model.normalize(h00 * q_a + h10 * h * qd_a + h01 * q_b + h11 * h * qd_b))
+            vs.append((1.0 - s_) * v_a + s_ * v_b)
+        return qs, vs
 
     recorded = None  # the search states the compiled run had after every accepted step
     if seed_path == "steps":
@@ -1204,12 +1280,8 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
         axle_bodies = np.unique(np.concatenate([np.asarray(s_.bw, dtype=np.int64).ravel() for s_ in kind.sets]))
     n_done = 0  # accepted steps replayed (seed_path "steps")
 
-    def carry(i, t, bs):  # the search state at row i (seed_path, docstring above)
+    def carry(i, t, bs):  # carry the element's search state to row i (seed_path, docstring above)
         nonlocal n_done
-        if recorded is not None:  # the state the run had after the last accepted step at or before t
-            m = int(np.searchsorted(S_t, float(t) + 1e-12 * max(1.0, abs(float(t))), side="right")) - 1
-            st.state = WheelRailKind.state_from_compiled(st, recorded[max(m, 0), e_row])
-            return
         if seed_path == "steps":
             if i == 0:  # the run's start: its first recorded state
                 kind.reset_state(model.body_states(S_q[0], S_v[0]), float(S_t[0]))
@@ -1232,85 +1304,103 @@ def contact_history(model, result, element=None, wheels=None, max_step=2e-3, at=
             kind.accept_step(model.body_states(qk, vk), t_prev + k / n_sub * h, reseed=True, check=False)
         kind.accept_step(bs, float(t), reseed=True, check=False)
 
-    def loaded_at(k, tau):
-        return wheels_at(k, tau)["Q [N]"] > 0.0
-
     sign = {"max": lambda x: x, "min": lambda x: -x, "absmax": np.abs}
     refine_peaks = at == "steps" and peak_samples > 0
-    best = {pc: (np.full(len(labels), -np.inf), np.full(len(labels), np.nan)) for pc in PEAK_COLUMNS}
-    recent: list[tuple] = []  # the wheel outputs of the last three rows, with their signed peak columns
+    best = {pc: (np.full(nw, -np.inf), np.full(nw, np.nan)) for pc in PEAK_COLUMNS}
+    # the rows' wheel quantities that the lift location and the peaks read (per row, (nw,))
+    wanted = sorted({"Q [N]"} | {col for col, _ in PEAK_COLUMNS})
+    if recorded is not None:
+        # every row with the state the run had after the last accepted step at or before it:
+        # the rows are independent, evaluated ROW_BATCH at a time
+        m_of = np.maximum(np.searchsorted(S_t, T + 1e-12 * np.maximum(1.0, np.abs(T)), side="right") - 1, 0)
 
-    def consider_peaks(i):  # row i - 1 a local extreme of some (column, wheel)? refine over (T[i-2], T[i])
-        b = recent[-2][0]
+        def row_state(i):
+            return WheelRailKind.state_from_compiled(st, recorded[m_of[i], e_row])
+
+        parts = {col: [] for col in wanted}
+        for c0 in range(0, len(T), ROW_BATCH):
+            idx = range(c0, min(len(T), c0 + ROW_BATCH))
+            out = evaluate([Qs[i] for i in idx], [Vs[i] for i in idx], [row_state(i) for i in idx])
+            rows.append(table_rows(T[c0:c0 + len(idx)], out))
+            for col in parts:
+                parts[col].append(np.asarray(out["wheels"][col], float))
+        W_rows = {col: np.concatenate(p_).reshape(len(T), nw) for col, p_ in parts.items()}
+
+    def wheels_at(k, taus, state):  # wheel outputs at states interpolated in the step (T[k - 1], T[k])
+        qs, vs = interpolated(k, taus)
+        return evaluate(qs, vs, [state] * len(taus))["wheels"]
+
+    def consider_peaks(i, recent, state_of):
+        """Row i - 1 a local extreme of some (column, wheel)?  Refine over (T[i - 2], T[i]), at
+        interpolated states with the search state of row i (``state_of()``, read only then)."""
         todo = []
         for pc in PEAK_COLUMNS:
-            xa, xb, xc = (r_[1][pc] for r_ in recent[-3:])
+            xa, xb, xc = (r_[0][pc] for r_ in recent)
             with np.errstate(invalid="ignore"):
                 # a smooth peak exceeds its best sample by at most 1/8 of the larger change to
                 # the neighbours (a parabola sampled with the peak midway between samples): 1/4 kept
-                room = 0.25 * np.nan_to_num(np.maximum(np.abs(xb - xa), np.abs(xb - xc)), nan=0.0, posinf=0.0)
+                change = np.maximum(np.abs(xb - xa), np.abs(xb - xc))
+                room = 0.25 * np.where(np.isfinite(change), change, 0.0)
                 cand = (xb >= xa) & (xb >= xc) & np.isfinite(xb) & (xb + room > best[pc][0])
             if cand.any():
                 todo.append((pc, np.flatnonzero(cand)))
         if not todo:
             return
-        samples = []
-        for k in (i - 1, i):
-            for j in range(1, peak_samples):
-                tau = float(T[k - 1]) + j / peak_samples * (float(T[k]) - float(T[k - 1]))
-                samples.append((tau, wheels_at(k, tau)))
-        samples.append((float(T[i - 1]), b))
+        taus, qs, vs = [], [], []
+        for k in (i - 1, i):  # both steps' samples in one call
+            tk = [float(T[k - 1]) + j / peak_samples * (float(T[k]) - float(T[k - 1])) for j in range(1, peak_samples)]
+            qk, vk = interpolated(k, tk)
+            taus, qs, vs = taus + tk, qs + qk, vs + vk
+        sampled = evaluate(qs, vs, [state_of()] * len(qs))["wheels"]
+        taus.append(float(T[i - 1]))  # the row itself, last (the first sample wins a tie)
         for pc, ws_ in todo:
             col, kd = pc
+            vals = np.concatenate([np.asarray(sampled[col], float).reshape(-1, nw), recent[1][1][col][None, :]])
+            vals = np.nan_to_num(sign[kd](vals), nan=-np.inf)
             for w_ in ws_:
-                vals = np.array([np.nan_to_num(sign[kd](float(r_[col][w_])), nan=-np.inf) for _, r_ in samples])
-                j = int(np.argmax(vals))
-                if vals[j] > best[pc][0][w_]:
-                    best[pc][0][w_], best[pc][1][w_] = vals[j], samples[j][0]
+                j = int(np.argmax(vals[:, w_]))
+                if vals[j, w_] > best[pc][0][w_]:
+                    best[pc][0][w_], best[pc][1][w_] = vals[j, w_], taus[j]
 
     prev_loaded = None
+    recent: list[tuple] = []  # the last three rows: (their signed peak columns, their quantities)
     try:
         for i, t in enumerate(T):
-            bs = model.body_states(Qs[i], Vs[i])
-            carry(i, t, bs)
-            out = kind.contact_outputs(bs, float(t), st.name)
-            loaded = np.asarray(out["wheels"]["Q [N]"]) > 0.0
+            if recorded is not None:
+                wq = {col: W_rows[col][i] for col in wanted}
+                state_i = None  # the row's search state, read when needed
+            else:
+                bs = model.body_states(Qs[i], Vs[i])
+                carry(i, t, bs)
+                state_i = st.state
+                out = evaluate([Qs[i]], [Vs[i]], [state_i])
+                rows.append(table_rows([t], out))
+                wq = {col: np.asarray(out["wheels"][col], float) for col in wanted}
+            loaded = wq["Q [N]"] > 0.0
             if locate_lift and prev_loaded is not None and np.any(loaded != prev_loaded):
+                if state_i is None:
+                    state_i = row_state(i)
                 ta, tb = float(T[i - 1]), float(t)
                 for w_ in np.flatnonzero(loaded != prev_loaded):
                     lo, hi = ta, tb  # the condition at lo is prev_loaded[w_], at hi loaded[w_]
                     while hi - lo > lift_tol:
                         mid = 0.5 * (lo + hi)
-                        if loaded_at(i, mid)[w_] == prev_loaded[w_]:
+                        if (np.asarray(wheels_at(i, [mid], state_i)["Q [N]"])[w_] > 0.0) == prev_loaded[w_]:
                             lo = mid
                         else:
                             hi = mid
                     crossings[labels[w_]][tb] = 0.5 * (lo + hi)
             prev_loaded = loaded
             if refine_peaks:
-                signed = {pc: np.nan_to_num(sign[pc[1]](np.asarray(out["wheels"][pc[0]], float)), nan=-np.inf)
+                signed = {pc: np.nan_to_num(sign[pc[1]](wq[pc[0]]), nan=-np.inf)
                           for pc in PEAK_COLUMNS}  # once per row, for the best and the candidates
-                recent.append((out["wheels"], signed))
+                recent.append((signed, wq))
                 for pc, x in signed.items():  # every sample counts (the first, the last, a plateau)
                     better = x > best[pc][0]
                     best[pc][0][better], best[pc][1][better] = x[better], float(t)
                 if len(recent) >= 3:
-                    consider_peaks(i)
+                    consider_peaks(i, recent, (lambda: state_i) if state_i is not None else (lambda: row_state(i)))
                     recent.pop(0)
-            r, A, v, w = st.states(bs)
-            speed = np.einsum("nk,nk->n", v, st.track.evaluate_raw(np.nan_to_num(out["wheelsets"]["s [m]"]))[3][:, :, 0])
-            n = 2 * st.n_ws
-            row = {"t [s]": np.full(n, float(t)),
-                   "wheel": list(labels),
-                   "wheelset": np.repeat(st.wheelset_names, 2), "side": ["left", "right"] * st.n_ws}
-            row.update({k: np.asarray(v_) for k, v_ in out["wheels"].items()})
-            for k in ("N [N]", "Fx [N]", "Fy [N]", "xi [-]", "eta [-]", "phi [1/m]"):
-                for c, lab in enumerate(("tread", "flange")):
-                    row[f"{k.split(' ')[0]}_{lab} {k.split(' ')[1]}"] = out["contacts"][k][:, c]
-            for k, v_ in out["wheelsets"].items():
-                row[k] = np.repeat(np.asarray(v_), 2)
-            row["speed [m/s]"] = np.repeat(speed, 2)
-            rows.append(row)
     finally:
         st.state = saved
     df = pd.DataFrame({k: np.concatenate([np.asarray(r_[k]) for r_ in rows]) for k in rows[0]})

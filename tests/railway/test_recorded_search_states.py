@@ -61,3 +61,43 @@ def test_the_replay_with_the_recorded_states_agrees_with_the_carried_search(run)
         a, b = recorded[column].to_numpy(), carried[column].to_numpy()
         same &= np.isclose(a, b, rtol=1e-9, atol=1e-6) | (np.isnan(a) & np.isnan(b))
     assert same.mean() > 0.99, f"{(~same).sum()} of {len(same)} rows differ"
+
+
+@pytest.fixture(scope="module")
+def coach_run():
+    from railway.vehicles.curving import run_curving
+
+    res, veh = run_curving("polach2000", 20.0, T=0.25, record_steps=True)
+    assert res.status == "finished", res.message
+    return veh.model, res
+
+
+def test_the_rows_evaluated_side_by_side_equal_the_rows_evaluated_one_at_a_time(coach_run):
+    """contact_history evaluates a recorded run's rows ROW_BATCH at a time, the four wheelsets of
+    every row side by side (railway.vehicles.wheel_rail._Set.batched).  The independent
+    computation: the element's own contact_outputs at each step, with the state recorded there.
+    Problems do not interact, so the two agree to round-off (the vectorised track projection
+    iterates every wheelset until the last one converged: a few ulps), wheel and wheelset alike."""
+    import railway.vehicles.wheel_rail as wr
+
+    model, res = coach_run
+    kind = next(k for k in model.force_kinds if isinstance(k, WheelRailKind))
+    st = kind.sets[0]
+    states = search_states_at_steps(res, kind.names)
+    H = contact_history(model, res, at="steps")
+    nw = 2 * st.n_ws
+    assert st.n_ws == 4 and len(H) == nw * res.steps.t.size and res.steps.t.size > wr.ROW_BATCH
+    saved = st.state
+    try:
+        for k in (0, 1, wr.ROW_BATCH - 1, wr.ROW_BATCH, res.steps.t.size - 1):  # across a batch boundary
+            st.state = WheelRailKind.state_from_compiled(st, states[k, 0])
+            out = kind.contact_outputs(model.body_states(res.steps.q[k], res.steps.v[k]), float(res.steps.t[k]))
+            rows = H.iloc[k * nw:(k + 1) * nw]
+            assert np.all(rows["t [s]"] == res.steps.t[k])
+            for column in ("Q [N]", "Y [N]", "flange force [N]", "contact angle [rad]", "T gamma [N]", "y_wheel [m]"):
+                np.testing.assert_allclose(rows[column].to_numpy(), out["wheels"][column], rtol=1e-12, atol=1e-12,
+                                           err_msg=f"{column} at step {k}")
+            np.testing.assert_allclose(rows["angle of attack [rad]"].to_numpy(),
+                                       np.repeat(out["wheelsets"]["angle of attack [rad]"], 2), rtol=1e-12, atol=1e-15)
+    finally:
+        st.state = saved

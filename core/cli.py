@@ -251,6 +251,10 @@ def _sweep_executor(args: argparse.Namespace):
 
 
 def _run_selected(selected, out_dir, args, executor, tqdm) -> int:
+    import concurrent.futures
+
+    if isinstance(executor, concurrent.futures.ProcessPoolExecutor) and len(selected) > 1:
+        return _run_side_by_side(selected, out_dir, args, executor, tqdm)
     failed: list[str] = []
     begin = time.perf_counter()
     bar = tqdm(selected, desc="scenes", unit="scene", disable=None)
@@ -275,6 +279,39 @@ def _run_selected(selected, out_dir, args, executor, tqdm) -> int:
         return EXIT_FAILURE
     print(f"mbsuite: {len(selected)} scene(s) written to {out_dir} in {time.perf_counter() - begin:.0f} s "
           f"(mode {args.mode}); index: {out_dir / 'README.md'}")
+    return EXIT_OK
+
+
+def _run_side_by_side(selected, out_dir, args, pool, tqdm) -> int:
+    """Several scenes on a local pool: the sweep scenes here, the others whole in the pool's free
+    processes (:mod:`core.scene_scheduler`)."""
+    import threading
+
+    from .scene_scheduler import run_scenes
+
+    begin = time.perf_counter()
+    bar = tqdm(total=len(selected), desc="scenes", unit="scene", disable=None)
+    lock = threading.Lock()
+
+    def report(o) -> None:
+        with lock:
+            if o.ok:
+                tqdm.write(f"ok     {o.name} -> {out_dir / o.name} ({o.tables} tables, {o.figures} figures, "
+                           f"{o.wall_time_s:.1f} s{', in a pool process' if o.where == 'pool' else ''})")
+            else:
+                tqdm.write(f"FAILED {o.name}: {o.message}", file=sys.stderr)
+            bar.update(1)
+
+    outcomes = run_scenes(selected, out_dir, pool, args.workers, mode=args.mode, progress=tqdm_progress,
+                          report=report)
+    bar.close()
+    write_index(out_dir)
+    failed = [o.name for o in outcomes if not o.ok]
+    if failed:
+        print(f"mbsuite: {len(failed)} of {len(selected)} scene(s) failed: {', '.join(failed)}", file=sys.stderr)
+        return EXIT_FAILURE
+    print(f"mbsuite: {len(selected)} scene(s) written to {out_dir} in {time.perf_counter() - begin:.0f} s "
+          f"(mode {args.mode}; {args.workers} processes, scenes side by side); index: {out_dir / 'README.md'}")
     return EXIT_OK
 
 

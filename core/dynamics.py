@@ -87,6 +87,9 @@ __all__ = [
 RANK_RCOND = 1e-12
 #: Systems up to this many velocity coordinates use dense Schur complements.
 _DENSE_MAX = 400
+#: Saddle-point matrices up to this order are factored dense where M has no inverse (a point
+#: mass's zero rotational inertia): building the sparse matrix costs more than the dense LU there.
+_DENSE_KKT_MAX = 120
 
 
 def _dense(A) -> Array:
@@ -320,6 +323,16 @@ class _Factor:
             except (np.linalg.LinAlgError, RuntimeError, ValueError):
                 self.mode = None
                 self.J = J
+        if self.mode is None and not owner.minimum_norm and J.shape[1] + self.n_c <= _DENSE_KKT_MAX:
+            Md = self.M.toarray() if sp.issparse(self.M) else np.asarray(self.M, float)
+            Jd = J.toarray() if sp.issparse(J) else np.asarray(J, float)
+            Gd = Jd if G is J else (G.toarray() if sp.issparse(G) else np.asarray(G, float))
+            K = np.block([[Md, Gd.T], [Jd, np.zeros((self.n_c, self.n_c))]])
+            if np.all(np.isfinite(K)):
+                lu = sla.lu_factor(K, check_finite=False)
+                d = np.abs(np.diag(lu[0]))
+                if d.min() > 1e-13 * max(d.max(), 1e-300):  # else singular: the sparse and minimum-norm routes
+                    self.fac, self.K, self.mode = lu, K, "kkt-dense"
         if self.mode is None and not owner.minimum_norm:
             try:
                 K = kkt_matrix(self.M, J) if G is J else sp.bmat(
@@ -352,9 +365,9 @@ class _Factor:
             else:
                 mu = self.fac.solve(r)
             return x0 - self.MGt @ mu, mu
-        if mode == "kkt":
+        if mode in ("kkt", "kkt-dense"):
             rhs = np.concatenate([f, g])
-            sol = self.fac.solve(rhs)
+            sol = self.fac.solve(rhs) if mode == "kkt" else sla.lu_solve(self.fac, rhs, check_finite=False)
             res = self.K @ sol - rhs
             if np.all(np.isfinite(sol)) and np.linalg.norm(res) <= 1e-8 * (1.0 + np.linalg.norm(rhs)):
                 return sol[:n_v], sol[n_v:]

@@ -174,6 +174,10 @@ class Scene:
     full_adds : str, optional
         What ``mbsuite run --full`` computes beyond the default run (said in the README of a
         default run); empty when the default run is already complete.
+    sweeps : bool, optional
+        The scene runs cases on ``ctx.executor`` (:func:`core.sweep.run_sweep`).  ``mbsuite run``
+        runs such scenes in its own process, their cases on the pool, and every other scene whole
+        in a pool process beside them (:mod:`core.scene_scheduler`).
     """
 
     name: str
@@ -181,6 +185,7 @@ class Scene:
     description: str
     run: Callable[[SceneContext], SceneResult]
     full_adds: str = ""
+    sweeps: bool = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not _NAME_RE.match(self.name):
@@ -459,7 +464,12 @@ def example_scene(name: str, script: str | Path, title: str, description: str, f
         return collected["result"]
 
     run.__doc__ = f"Runs the example script examples/{script}."
-    return Scene(name, title, description, run, full_adds=full_adds)
+    # a script that reads its run's executor sweeps (scene_run(...).executor, core.sweep.run_sweep)
+    try:
+        sweeps = re.search(r"\.executor\b", example_path(script).read_text(encoding="utf-8")) is not None
+    except OSError:  # no such script: running the scene says so, naming the path
+        sweeps = False
+    return Scene(name, title, description, run, full_adds=full_adds, sweeps=sweeps)
 
 
 def _env_workers() -> int:

@@ -129,6 +129,8 @@ def executor_workers(executor: concurrent.futures.Executor | None) -> int | None
     """
     if executor is None:
         return 1
+    if isinstance(getattr(executor, "max_workers", None), int):  # core.scene_scheduler.SlotExecutor
+        return int(executor.max_workers)
     if isinstance(executor, (concurrent.futures.ProcessPoolExecutor, concurrent.futures.ThreadPoolExecutor)):
         return int(executor._max_workers)  # the standard library keeps it only here
     return None

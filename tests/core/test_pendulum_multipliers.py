@@ -47,3 +47,25 @@ def test_pendulum_reaction_equals_closed_form_multiplier(method, kw):
     # and the closed form itself at the bottom: T = 3 m g for a release from horizontal at rest
     k = int(np.argmin(y))
     assert abs(np.hypot(*F[k, :2]) - (m * vx[k] ** 2 / l + m * vy[k] ** 2 / l + m * G * (-y[k] / l))) < tol
+
+
+def test_a_point_mass_saddle_point_is_factored_dense_and_agrees_with_the_sparse_route(monkeypatch):
+    """A point-mass bob has no rotational inertia: M has no inverse, so the saddle-point solver
+    factors [[M, Φ_qᵀ], [Φ_q, 0]] whole.  Small ones are factored dense (core.dynamics._DENSE_KKT_MAX);
+    the sparse LU is the independent computation: the same solution for any right-hand side, to
+    round-off."""
+    import core.dynamics as dyn
+
+    system = models.simple_pendulum(length=1.0, mass=1.0, angle0=np.pi / 3, planar=True, bob="point")
+    t, q = 0.0, system.q0
+    J = system.Phi_q(t, q)
+    rng = np.random.default_rng(3)
+    f, g = rng.normal(size=system.n_v), rng.normal(size=J.shape[0])
+    dense = dyn.SaddleSolver(system, {"n_factor": 0}).factor(t, q, J)
+    assert dense.mode == "kkt-dense"
+    monkeypatch.setattr(dyn, "_DENSE_KKT_MAX", 0)
+    sparse = dyn.SaddleSolver(system, {"n_factor": 0}).factor(t, q, J)
+    assert sparse.mode == "kkt"
+    (xd, md), (xs, ms) = dense.solve(f, g), sparse.solve(f, g)
+    np.testing.assert_allclose(xd, xs, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(md, ms, rtol=1e-12, atol=1e-12)

@@ -273,12 +273,17 @@ def _run_selected(selected, out_dir, args, executor, tqdm) -> int:
             f"({len(result.tables)} tables, {len(result.figures)} figures, {time.perf_counter() - start:.1f} s)"
         )
     bar.close()
+    return _finish_run(selected, failed, out_dir, begin, f"mode {args.mode}")
+
+
+def _finish_run(selected, failed, out_dir, begin, how) -> int:
+    """The index of ``out_dir`` and the command's last line and exit status."""
     write_index(out_dir)
     if failed:
         print(f"mbsuite: {len(failed)} of {len(selected)} scene(s) failed: {', '.join(failed)}", file=sys.stderr)
         return EXIT_FAILURE
     print(f"mbsuite: {len(selected)} scene(s) written to {out_dir} in {time.perf_counter() - begin:.0f} s "
-          f"(mode {args.mode}); index: {out_dir / 'README.md'}")
+          f"({how}); index: {out_dir / 'README.md'}")
     return EXIT_OK
 
 
@@ -305,14 +310,8 @@ def _run_side_by_side(selected, out_dir, args, pool, tqdm) -> int:
     outcomes = run_scenes(selected, out_dir, pool, args.workers, mode=args.mode, progress=tqdm_progress,
                           report=report)
     bar.close()
-    write_index(out_dir)
-    failed = [o.name for o in outcomes if not o.ok]
-    if failed:
-        print(f"mbsuite: {len(failed)} of {len(selected)} scene(s) failed: {', '.join(failed)}", file=sys.stderr)
-        return EXIT_FAILURE
-    print(f"mbsuite: {len(selected)} scene(s) written to {out_dir} in {time.perf_counter() - begin:.0f} s "
-          f"(mode {args.mode}; {args.workers} processes, scenes side by side); index: {out_dir / 'README.md'}")
-    return EXIT_OK
+    return _finish_run(selected, [o.name for o in outcomes if not o.ok], out_dir, begin,
+                       f"mode {args.mode}; {args.workers} processes, scenes side by side")
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:

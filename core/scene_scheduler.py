@@ -99,6 +99,7 @@ class SlotExecutor(concurrent.futures.Executor):
         self._changed = changed
 
     def submit(self, fn, /, *args, **kwargs):
+        """The pool's ``submit(fn, ...)``, counted in flight until the future is done."""
         self._changed(+1)
         try:
             future = self._pool.submit(fn, *args, **kwargs)
@@ -108,7 +109,8 @@ class SlotExecutor(concurrent.futures.Executor):
         future.add_done_callback(lambda _f: self._changed(-1))
         return future
 
-    def shutdown(self, wait=True, *, cancel_futures=False):  # the pool is the caller's
+    def shutdown(self, wait=True, *, cancel_futures=False):
+        """Nothing: the pool belongs to the caller of :func:`run_scenes`."""
         return None
 
 

@@ -1,0 +1,27 @@
+"""Flexible bodies: the finite-element models and their modal reduction (issue 23).
+
+A flexible body in a multibody model is described, as in Shabana's floating frame of reference and
+in the standard input data that Simpack and Adams read, by a reduced linear elastic component: a
+few mode shapes of a finite-element model, their modal mass and stiffness, and the shapes at the
+nodes where joints and forces attach.  This package makes those components:
+
+* :mod:`core.flexible.beam` -- beam finite elements (Euler–Bernoulli and Timoshenko, planar and
+  spatial), consistent mass and stiffness, assembled sparse;
+* :mod:`core.flexible.fe_model` -- a component's nodes, mass and stiffness, from the beam elements
+  or read from another FE code (Matrix Market matrices, CSV nodes, the model's units converted);
+* :mod:`core.flexible.reduction` -- normal modes with scipy's sparse eigensolver, Craig–Bampton
+  reduction (fixed-interface modes plus the static constraint modes of the interface nodes) and
+  free-interface modes with static correction (residual attachment modes with inertia relief),
+  into a :class:`~core.flexible.reduction.ModalComponent`.
+
+Still to come (issue 23): the floating-frame body kind in the core's absolute coordinates (inertia
+invariants, quadratic-velocity and elastic forces, geometric stiffening, markers on nodes), plane
+and solid models through scikit-fem, HDF5 import.
+"""
+
+from .beam import BeamMesh, BeamSection, beam_matrices, straight_beam
+from .fe_model import FEModel
+from .reduction import ModalComponent, craig_bampton, free_interface, normal_modes, rigid_body_modes
+
+__all__ = ["BeamMesh", "BeamSection", "FEModel", "ModalComponent", "beam_matrices", "craig_bampton", "free_interface",
+           "normal_modes", "rigid_body_modes", "straight_beam"]

@@ -1,0 +1,340 @@
+r"""Beam finite elements, planar and spatial, Euler–Bernoulli and Timoshenko.
+
+Two-node elements of length :math:`L` with consistent mass.  Local axes: :math:`x` along the
+element from node i to node j; in space :math:`y` in the plane of :math:`x` and the section's
+orientation vector, :math:`z = x \times y`.
+
+Degrees of freedom per node
+---------------------------
+* planar (3): :math:`u_x, u_y, \theta_z` (global);
+* spatial (6): :math:`u_x, u_y, u_z, \theta_x, \theta_y, \theta_z` (global).
+
+Equations (local axes)
+----------------------
+Axial, bar with linear shape functions:
+
+.. math::
+
+    K_a = \frac{EA}{L}\begin{bmatrix}1&-1\\-1&1\end{bmatrix},\qquad
+    M_a = \frac{\rho A L}{6}\begin{bmatrix}2&1\\1&2\end{bmatrix};
+
+torsion alike with :math:`GJ` and :math:`\rho I_p` (:math:`J` the torsion constant, :math:`I_p`
+the polar second moment).  Bending in the :math:`x`–:math:`y` plane on
+:math:`(v_i, \theta_{z,i}, v_j, \theta_{z,j})` with :math:`\Phi = 12 EI_z/(\kappa G A L^2)`
+(:math:`\Phi = 0`: Euler–Bernoulli):
+
+.. math::
+
+    K_b = \frac{EI_z}{(1+\Phi)L^3}\begin{bmatrix}
+      12 & 6L & -12 & 6L\\ 6L & (4+\Phi)L^2 & -6L & (2-\Phi)L^2\\
+      -12 & -6L & 12 & -6L\\ 6L & (2-\Phi)L^2 & -6L & (4+\Phi)L^2\end{bmatrix}
+
+(Przemieniecki 1968, *Theory of Matrix Structural Analysis*, eq. 5.116), and the consistent mass
+of the Timoshenko element, translational and rotary parts (Friedman & Kosmatka 1993, Computers &
+Structures 47(3):473–481, eqs. 17–18):
+
+.. math::
+
+    M_{\rho A} = \frac{\rho A L}{210(1+\Phi)^2}\begin{bmatrix}
+      70\Phi^2+147\Phi+78 & (35\Phi^2+77\Phi+44)\frac L4 & 35\Phi^2+63\Phi+27 & -(35\Phi^2+63\Phi+26)\frac L4\\
+      & (7\Phi^2+14\Phi+8)\frac{L^2}4 & (35\Phi^2+63\Phi+26)\frac L4 & -(7\Phi^2+14\Phi+6)\frac{L^2}4\\
+      & & 70\Phi^2+147\Phi+78 & -(35\Phi^2+77\Phi+44)\frac L4\\
+      \text{sym.} & & & (7\Phi^2+14\Phi+8)\frac{L^2}4\end{bmatrix},
+
+.. math::
+
+    M_{\rho I} = \frac{\rho I_z}{30(1+\Phi)^2 L}\begin{bmatrix}
+      36 & (3-15\Phi)L & -36 & (3-15\Phi)L\\
+      & (4+5\Phi+10\Phi^2)L^2 & -(3-15\Phi)L & (-1-5\Phi+5\Phi^2)L^2\\
+      & & 36 & -(3-15\Phi)L\\
+      \text{sym.} & & & (4+5\Phi+10\Phi^2)L^2\end{bmatrix}.
+
+At :math:`\Phi = 0` :math:`M_{\rho A}` is the classical :math:`\rho A L/420\,[156, 22L, 54, -13L; \dots]`.
+The Euler–Bernoulli element has no rotary inertia (the closed forms it is checked against have
+none); the Timoshenko element has shear deformation and rotary inertia.  Bending in the
+:math:`x`–:math:`z` plane uses the same matrices on :math:`(w_i, -\theta_{y,i}, w_j, -\theta_{y,j})`
+with :math:`I_y` (a positive :math:`\theta_y` lowers :math:`w` along :math:`x`).
+
+Global matrices: :math:`K = T^\mathsf{T} K_\ell T` with :math:`T` the rotation of every node's
+translations and rotations into the local axes; assembled into scipy sparse matrices.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError
+from ..inputs import parse_quantity
+
+__all__ = ["BeamMesh", "BeamSection", "beam_matrices", "straight_beam", "THEORIES"]
+
+THEORIES = ("euler-bernoulli", "timoshenko")
+
+
+@dataclass(frozen=True)
+class BeamSection:
+    """Material and cross-section of a beam, SI units (a number, or a string with its unit such as
+    ``"210 GPa"``).
+
+    Parameters
+    ----------
+    E : Young's modulus [Pa]
+    rho : density [kg/m^3]
+    A : area [m^2]
+    Iz : second moment about the local z axis [m^4] (bending in the x–y plane; the planar one)
+    Iy : second moment about the local y axis [m^4] (bending in the x–z plane); default ``Iz``
+    G : shear modulus [Pa]; default from ``nu``: E / (2 (1 + nu))
+    nu : Poisson's ratio [-], default 0.3 (used only when G is not given)
+    J : torsion constant [m^4]; default ``Iy + Iz`` (a circular section)
+    Ip : polar second moment for the rotary inertia of torsion [m^4]; default ``Iy + Iz``
+    shear_factor : Timoshenko's shear coefficient kappa [-]; default 5/6 (a rectangle)
+    """
+
+    E: float
+    rho: float
+    A: float
+    Iz: float
+    Iy: float | None = None
+    G: float | None = None
+    nu: float = 0.3
+    J: float | None = None
+    Ip: float | None = None
+    shear_factor: float = 5.0 / 6.0
+
+    def __post_init__(self):
+        units = {"E": "Pa", "rho": "kg/m^3", "A": "m^2", "Iz": "m^4", "Iy": "m^4", "G": "Pa", "nu": "1",
+                 "J": "m^4", "Ip": "m^4", "shear_factor": "1"}
+        for name, unit in units.items():
+            value = getattr(self, name)
+            if value is None:
+                continue
+            v = parse_quantity(value, unit, where=f"beam section {name}")
+            if name == "nu":
+                if not -1.0 < v < 0.5:
+                    raise InputError(f"beam section nu = {v!r}: Poisson's ratio must lie in (-1, 0.5)")
+            elif not v > 0.0:
+                raise InputError(f"beam section {name} = {v!r} {unit}: must be positive")
+            object.__setattr__(self, name, v)
+        if self.Iy is None:
+            object.__setattr__(self, "Iy", self.Iz)
+        if self.G is None:
+            object.__setattr__(self, "G", self.E / (2.0 * (1.0 + self.nu)))
+        for name in ("J", "Ip"):
+            if getattr(self, name) is None:
+                object.__setattr__(self, name, self.Iy + self.Iz)
+
+    @classmethod
+    def rectangle(cls, E, rho, width, height, **kw) -> BeamSection:
+        """A solid rectangle ``width`` (local y) by ``height`` (local z): A = b h, Iz = h b³/12,
+        Iy = b h³/12, torsion constant J = β b h³ with Roark's series for the larger side b ≥ h,
+        κ = 5/6."""
+        b, h = (parse_quantity(x, "m", where=f"rectangle {n}") for x, n in ((width, "width"), (height, "height")))
+        if not (b > 0 and h > 0):
+            raise InputError(f"rectangle {b!r} m by {h!r} m: both sides must be positive")
+        long, short = max(b, h), min(b, h)
+        # Young & Budynas, Roark's Formulas for Stress and Strain, 7th ed., table 10.7 case 4
+        J = long * short**3 * (1.0 / 3.0 - 0.21 * short / long * (1.0 - short**4 / (12.0 * long**4)))
+        return cls(E=E, rho=rho, A=b * h, Iz=h * b**3 / 12.0, Iy=b * h**3 / 12.0, J=kw.pop("J", J), **kw)
+
+    @classmethod
+    def circle(cls, E, rho, diameter, **kw) -> BeamSection:
+        """A solid circle: A = π d²/4, Iy = Iz = π d⁴/64, J = Ip = π d⁴/32, κ = 6 (1 + ν)/(7 + 6 ν)
+        (Cowper 1966)."""
+        d = parse_quantity(diameter, "m", where="circle diameter")
+        if not d > 0:
+            raise InputError(f"circle diameter {d!r} m must be positive")
+        nu = parse_quantity(kw.get("nu", 0.3), "1", where="beam section nu")
+        kw.setdefault("shear_factor", 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu))
+        return cls(E=E, rho=rho, A=np.pi * d**2 / 4.0, Iz=np.pi * d**4 / 64.0, **kw)
+
+
+@dataclass(frozen=True)
+class BeamMesh:
+    """Nodes (N, 2) or (N, 3) [m] and two-node elements (n_el, 2) of node indices; in space an
+    ``orientation`` vector that, with each element's axis, spans its local x–y plane."""
+
+    nodes: np.ndarray
+    elements: np.ndarray
+    orientation: tuple[float, float, float] = (0.0, 0.0, 1.0)
+
+    def __post_init__(self):
+        nodes = np.asarray(self.nodes, float)
+        if nodes.ndim != 2 or nodes.shape[1] not in (2, 3) or nodes.shape[0] < 2:
+            raise InputError(f"beam mesh: nodes must be an (N, 2) or (N, 3) array with N >= 2, got shape "
+                             f"{nodes.shape}")
+        if not np.all(np.isfinite(nodes)):
+            raise InputError(f"beam mesh: node {int(np.argmax(~np.isfinite(nodes).all(axis=1)))} is not finite")
+        el = np.asarray(self.elements)
+        if el.ndim != 2 or el.shape[1] != 2 or el.shape[0] < 1 or not np.issubdtype(el.dtype, np.integer):
+            raise InputError(f"beam mesh: elements must be an (n_el, 2) integer array, got shape {el.shape}")
+        bad = np.flatnonzero((el < 0).any(axis=1) | (el >= nodes.shape[0]).any(axis=1))
+        if bad.size:
+            raise InputError(f"beam mesh: element {int(bad[0])} {el[bad[0]].tolist()} names a node outside "
+                             f"0..{nodes.shape[0] - 1}")
+        lengths = np.linalg.norm(nodes[el[:, 1]] - nodes[el[:, 0]], axis=1)
+        short = np.flatnonzero(~(lengths > 0.0))
+        if short.size:
+            raise InputError(f"beam mesh: element {int(short[0])} joins node {int(el[short[0], 0])} to itself "
+                             "(zero length)")
+        object.__setattr__(self, "nodes", nodes)
+        object.__setattr__(self, "elements", el.astype(np.int64))
+
+    @property
+    def dim(self) -> int:
+        return self.nodes.shape[1]
+
+    @property
+    def dofs_per_node(self) -> int:
+        """3 in the plane (u_x, u_y, θ_z), 6 in space (u, θ)."""
+        return 3 if self.dim == 2 else 6
+
+    @property
+    def n_dofs(self) -> int:
+        return self.nodes.shape[0] * self.dofs_per_node
+
+    def dofs(self, node: int, which=None) -> np.ndarray:
+        """Global indices of a node's degrees of freedom (all, or ``which``: indices into the
+        node's list, e.g. ``[0, 1]`` for its translations in the plane)."""
+        n = self.dofs_per_node
+        k = np.arange(n) if which is None else np.asarray(which, np.int64)
+        return int(node) * n + k
+
+
+def straight_beam(length, n_elements: int, dim: int = 2, start=None, direction=None,
+                  orientation=(0.0, 0.0, 1.0)) -> BeamMesh:
+    """A straight beam of ``n_elements`` equal elements from ``start`` (default the origin) along
+    ``direction`` (default x)."""
+    L = parse_quantity(length, "m", where="beam length")
+    if not L > 0:
+        raise InputError(f"beam length {L!r} m must be positive")
+    if not (isinstance(n_elements, (int, np.integer)) and n_elements >= 1):
+        raise InputError(f"n_elements = {n_elements!r} must be a positive integer")
+    if dim not in (2, 3):
+        raise InputError(f"dim = {dim!r}: 2 (planar) or 3 (spatial)")
+    start = np.zeros(dim) if start is None else np.asarray(start, float).reshape(dim)
+    d = np.eye(dim)[0] if direction is None else np.asarray(direction, float).reshape(dim)
+    if not np.linalg.norm(d) > 0:
+        raise InputError("straight_beam: direction must be a non-zero vector")
+    d = d / np.linalg.norm(d)
+    s = np.linspace(0.0, L, n_elements + 1)
+    nodes = start[None, :] + s[:, None] * d[None, :]
+    elements = np.column_stack([np.arange(n_elements), np.arange(1, n_elements + 1)])
+    return BeamMesh(nodes, elements, orientation)
+
+
+def _bending(L, EI, rhoA, rhoI, phi, rotary: bool):
+    """(K, M) 4x4 of the bending element on (v_i, θ_i, v_j, θ_j) (module docstring)."""
+    c = EI / ((1.0 + phi) * L**3)
+    K = c * np.array([[12.0, 6 * L, -12.0, 6 * L],
+                      [6 * L, (4 + phi) * L**2, -6 * L, (2 - phi) * L**2],
+                      [-12.0, -6 * L, 12.0, -6 * L],
+                      [6 * L, (2 - phi) * L**2, -6 * L, (4 + phi) * L**2]])
+    p = phi
+    a1, a2, a3, a4 = 70 * p**2 + 147 * p + 78, (35 * p**2 + 77 * p + 44) * L / 4, 35 * p**2 + 63 * p + 27, \
+        (35 * p**2 + 63 * p + 26) * L / 4
+    a5, a6 = (7 * p**2 + 14 * p + 8) * L**2 / 4, (7 * p**2 + 14 * p + 6) * L**2 / 4
+    M = rhoA * L / (210.0 * (1 + p) ** 2) * np.array([[a1, a2, a3, -a4],
+                                                      [a2, a5, a4, -a6],
+                                                      [a3, a4, a1, -a2],
+                                                      [-a4, -a6, -a2, a5]])
+    if rotary:
+        b1, b2, b3 = 36.0, (3 - 15 * p) * L, (4 + 5 * p + 10 * p**2) * L**2
+        b4 = (-1 - 5 * p + 5 * p**2) * L**2
+        M = M + rhoI / (30.0 * (1 + p) ** 2 * L) * np.array([[b1, b2, -b1, b2],
+                                                              [b2, b3, -b2, b4],
+                                                              [-b1, -b2, b1, -b2],
+                                                              [b2, b4, -b2, b3]])
+    return K, M
+
+
+def _bar(L, k, m):
+    """(K, M) 2x2 of a bar (axial or torsion): stiffness k/L, mass m L/6 [2 1; 1 2]."""
+    return k / L * np.array([[1.0, -1.0], [-1.0, 1.0]]), m * L / 6.0 * np.array([[2.0, 1.0], [1.0, 2.0]])
+
+
+def _local_axes(mesh: BeamMesh, e: int) -> tuple[float, np.ndarray]:
+    """Length and the rotation R (rows: local x, y[, z] in global components) of element e."""
+    i, j = mesh.elements[e]
+    d = mesh.nodes[j] - mesh.nodes[i]
+    L = float(np.linalg.norm(d))
+    ex = d / L
+    if mesh.dim == 2:
+        return L, np.array([ex, [-ex[1], ex[0]]])
+    v = np.asarray(mesh.orientation, float)
+    ey = v - (v @ ex) * ex
+    if not np.linalg.norm(ey) > 1e-9 * max(np.linalg.norm(v), 1e-300):
+        raise InputError(f"beam mesh: element {e} lies along the orientation vector {v.tolist()}; give an "
+                         "orientation vector that is not parallel to the element")
+    ey /= np.linalg.norm(ey)
+    return L, np.array([ex, ey, np.cross(ex, ey)])
+
+
+def element_matrices(mesh: BeamMesh, section: BeamSection, e: int, theory: str = "euler-bernoulli"):
+    """Global-axes (K, M) of element e: (6, 6) in the plane, (12, 12) in space."""
+    L, R = _local_axes(mesh, e)
+    s = section
+    timo = theory == "timoshenko"
+    if mesh.dim == 2:
+        phi = 12 * s.E * s.Iz / (s.shear_factor * s.G * s.A * L**2) if timo else 0.0
+        Kl, Ml = np.zeros((6, 6)), np.zeros((6, 6))
+        Ka, Ma = _bar(L, s.E * s.A, s.rho * s.A)
+        ax = [0, 3]
+        Kl[np.ix_(ax, ax)] += Ka
+        Ml[np.ix_(ax, ax)] += Ma
+        Kb, Mb = _bending(L, s.E * s.Iz, s.rho * s.A, s.rho * s.Iz, phi, timo)
+        bd = [1, 2, 4, 5]
+        Kl[np.ix_(bd, bd)] += Kb
+        Ml[np.ix_(bd, bd)] += Mb
+        T = np.zeros((6, 6))
+        for n in (0, 3):
+            T[n:n + 2, n:n + 2] = R
+            T[n + 2, n + 2] = 1.0
+        return T.T @ Kl @ T, T.T @ Ml @ T
+    Kl, Ml = np.zeros((12, 12)), np.zeros((12, 12))
+    for k_, m_, dofs in ((s.E * s.A, s.rho * s.A, [0, 6]), (s.G * s.J, s.rho * s.Ip, [3, 9])):
+        Kx, Mx = _bar(L, k_, m_)
+        Kl[np.ix_(dofs, dofs)] += Kx
+        Ml[np.ix_(dofs, dofs)] += Mx
+    # x-y plane: (v, θz); x-z plane: (w, -θy)
+    for I, dofs, sign in ((s.Iz, [1, 5, 7, 11], np.array([1.0, 1.0, 1.0, 1.0])),
+                          (s.Iy, [2, 4, 8, 10], np.array([1.0, -1.0, 1.0, -1.0]))):
+        phi = 12 * s.E * I / (s.shear_factor * s.G * s.A * L**2) if timo else 0.0
+        Kb, Mb = _bending(L, s.E * I, s.rho * s.A, s.rho * I, phi, timo)
+        S = np.diag(sign)
+        Kl[np.ix_(dofs, dofs)] += S @ Kb @ S
+        Ml[np.ix_(dofs, dofs)] += S @ Mb @ S
+    T = np.zeros((12, 12))
+    for n in range(4):
+        T[3 * n:3 * n + 3, 3 * n:3 * n + 3] = R
+    return T.T @ Kl @ T, T.T @ Ml @ T
+
+
+def beam_matrices(mesh: BeamMesh, section: BeamSection, theory: str = "euler-bernoulli"):
+    """Assembled mass and stiffness of the mesh, ``(M, K)`` as scipy CSR matrices of order
+    ``mesh.n_dofs`` (free: no support; see :mod:`core.flexible.reduction` for fixed nodes)."""
+    if theory not in THEORIES:
+        from ..inputs import closest
+
+        raise InputError(f"beam theory {theory!r}: give one of {', '.join(THEORIES)}"
+                         + (f" (did you mean {closest(theory, THEORIES)!r}?)" if isinstance(theory, str) else ""))
+    if not isinstance(section, BeamSection):
+        raise InputError(f"beam_matrices: section must be a BeamSection, got {type(section).__name__}")
+    n = mesh.dofs_per_node
+    rows, cols, kv, mv = [], [], [], []
+    for e in range(mesh.elements.shape[0]):
+        Ke, Me = element_matrices(mesh, section, e, theory)
+        i, j = mesh.elements[e]
+        idx = np.concatenate([np.arange(n) + i * n, np.arange(n) + j * n])
+        r, c = np.meshgrid(idx, idx, indexing="ij")
+        rows.append(r.ravel())
+        cols.append(c.ravel())
+        kv.append(Ke.ravel())
+        mv.append(Me.ravel())
+    rows, cols = np.concatenate(rows), np.concatenate(cols)
+    shape = (mesh.n_dofs, mesh.n_dofs)
+    K = sp.csr_matrix((np.concatenate(kv), (rows, cols)), shape=shape)
+    M = sp.csr_matrix((np.concatenate(mv), (rows, cols)), shape=shape)
+    return M, K

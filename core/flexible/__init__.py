@@ -9,19 +9,21 @@ nodes where joints and forces attach.  This package makes those components:
   spatial), consistent mass and stiffness, assembled sparse;
 * :mod:`core.flexible.fe_model` -- a component's nodes, mass and stiffness, from the beam elements
   or read from another FE code (Matrix Market matrices, CSV nodes, the model's units converted);
+* :mod:`core.flexible.continuum` -- plane-stress and solid components assembled by scikit-fem;
 * :mod:`core.flexible.reduction` -- normal modes with scipy's sparse eigensolver, Craig–Bampton
   reduction (fixed-interface modes plus the static constraint modes of the interface nodes) and
   free-interface modes with static correction (residual attachment modes with inertia relief),
   into a :class:`~core.flexible.reduction.ModalComponent`.
 
 Still to come (issue 23): the floating-frame body kind in the core's absolute coordinates (inertia
-invariants, quadratic-velocity and elastic forces, geometric stiffening, markers on nodes), plane
-and solid models through scikit-fem, HDF5 import.
+invariants, quadratic-velocity and elastic forces, geometric stiffening, markers on nodes), HDF5
+import.
 """
 
 from .beam import BeamMesh, BeamSection, beam_matrices, straight_beam
+from .continuum import plane_stress_model, solid_model
 from .fe_model import FEModel
 from .reduction import ModalComponent, craig_bampton, free_interface, normal_modes, rigid_body_modes
 
 __all__ = ["BeamMesh", "BeamSection", "FEModel", "ModalComponent", "beam_matrices", "craig_bampton", "free_interface",
-           "normal_modes", "rigid_body_modes", "straight_beam"]
+           "normal_modes", "plane_stress_model", "rigid_body_modes", "solid_model", "straight_beam"]

@@ -1,0 +1,78 @@
+"""Plane-stress and solid components (core.flexible.continuum, assembled by scikit-fem) against
+the beam theory of the same bar and the closed forms of its axial and torsion modes."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import skfem
+
+from core.errors import InputError
+from core.flexible import (BeamSection, FEModel, free_interface, normal_modes, plane_stress_model, solid_model,
+                           straight_beam)
+
+E, NU, RHO = 210e9, 0.3, 7850.0
+L, H, T = 1.0, 0.1, 0.02
+
+
+def _clamped(fe):
+    root = np.flatnonzero(np.isclose(fe.nodes[:, 0], 0.0))
+    return np.concatenate([fe.dofs(k) for k in root])
+
+
+def test_a_plane_stress_cantilever_is_the_timoshenko_beam_of_its_section():
+    fe = plane_stress_model(skfem.MeshTri.init_tensor(np.linspace(0, L, 41), np.linspace(0, H, 5)),
+                            E="210 GPa", nu=NU, rho=RHO, thickness=T)
+    f = normal_modes(fe.M, fe.K, 4, fixed_dofs=_clamped(fe))[0]
+    beam = FEModel.from_beam(straight_beam(L, 200), BeamSection(E=E, rho=RHO, A=H * T, Iz=T * H**3 / 12, nu=NU),
+                             "timoshenko")
+    fb = normal_modes(beam.M, beam.K, 4, fixed_dofs=beam.dofs(0))[0]
+    # bending: 83.02 / 498.1 Hz against 82.89 / 496.8 Hz (the clamped face also holds the Poisson
+    # contraction, and the mesh has 4 quadratic triangles through the height)
+    np.testing.assert_allclose(f[:2], fb[:2], rtol=5e-3)
+    assert np.all(f[:2] > fb[:2])
+    # the first axial mode against (1/4L) sqrt(E/rho) = 1293.05 Hz (mode 3 or 4: it lies beside the third bending mode)
+    axial = np.sqrt(E / RHO) / (4 * L)
+    assert np.min(np.abs(f[2:] / axial - 1.0)) < 3e-3
+
+
+def test_a_solid_square_cantilever_bends_alike_both_ways_and_twists():
+    fe = solid_model(skfem.MeshTet.init_tensor(np.linspace(0, L, 21), np.linspace(0, H, 3), np.linspace(0, H, 3)),
+                     E=E, nu=NU, rho="7850 kg/m^3")
+    f = normal_modes(fe.M, fe.K, 5, fixed_dofs=_clamped(fe))[0]
+    sq = BeamSection.rectangle(E=E, rho=RHO, width=H, height=H, nu=NU)
+    beam = FEModel.from_beam(straight_beam(L, 100, dim=3), sq, "timoshenko")
+    fb = normal_modes(beam.M, beam.K, 5, fixed_dofs=beam.dofs(0))[0]
+    assert abs(f[1] / f[0] - 1.0) < 1e-3  # the square's two bending directions (the mesh is not symmetric)
+    np.testing.assert_allclose(f[:4], fb[:4], rtol=1.5e-2)
+    # torsion: Saint-Venant's sqrt(G J / rho Ip) / (4 L) with Roark's J = 0.1406 a^4; the clamped face
+    # also holds the warping, which stiffens it (here by 2 %)
+    G = E / (2 * (1 + NU))
+    torsion = np.sqrt(G * 0.1406 * H**4 / (RHO * H**4 / 6)) / (4 * L)
+    assert 0.0 < f[4] / torsion - 1.0 < 0.03
+
+
+def test_a_free_solid_reduces_with_its_six_rigid_body_modes():
+    fe = solid_model(skfem.MeshTet.init_tensor(np.linspace(0, L, 11), np.linspace(0, H, 2), np.linspace(0, H, 2)),
+                     E=E, nu=NU, rho=RHO)
+    comp = free_interface(fe.M, fe.K, fe.nodes, 3, 4)
+    assert comp.n_rigid == 6
+    f = comp.frequencies()
+    assert np.all(f[:6] < 1e-4 * f[6]) and f[6] > 400.0
+
+
+def test_careless_continuum_inputs_are_named():
+    tri = skfem.MeshTri.init_tensor(np.linspace(0, 1, 3), np.linspace(0, 0.1, 2))
+    tet = skfem.MeshTet.init_tensor(np.linspace(0, 1, 3), np.linspace(0, 0.1, 2), np.linspace(0, 0.1, 2))
+    with pytest.raises(InputError, match="needs a 2-D mesh"):
+        plane_stress_model(tet, E=E, nu=NU, rho=RHO, thickness=T)
+    with pytest.raises(InputError, match="needs a 3-D mesh"):
+        solid_model(tri, E=E, nu=NU, rho=RHO)
+    with pytest.raises(InputError, match="Poisson"):
+        solid_model(tet, E=E, nu=0.5, rho=RHO)
+    with pytest.raises(InputError, match="thickness"):
+        plane_stress_model(tri, E=E, nu=NU, rho=RHO, thickness=0.0)
+    with pytest.raises(InputError, match="MeshTri"):
+        plane_stress_model(object(), E=E, nu=NU, rho=RHO, thickness=T)
+    with pytest.raises(InputError, match="order"):
+        plane_stress_model(tri, E=E, nu=NU, rho=RHO, thickness=T, order=3)

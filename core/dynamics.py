@@ -329,7 +329,9 @@ class _Factor:
             Gd = Jd if G is J else (G.toarray() if sp.issparse(G) else np.asarray(G, float))
             K = np.block([[Md, Gd.T], [Jd, np.zeros((self.n_c, self.n_c))]])
             if np.all(np.isfinite(K)):
-                lu = sla.lu_factor(K, check_finite=False)
+                with warnings.catch_warnings():  # an exactly singular K is judged by its pivots below
+                    warnings.simplefilter("ignore", sla.LinAlgWarning)
+                    lu = sla.lu_factor(K, check_finite=False)
                 d = np.abs(np.diag(lu[0]))
                 if d.min() > 1e-13 * max(d.max(), 1e-300):  # else singular: the sparse and minimum-norm routes
                     self.fac, self.K, self.mode = lu, K, "kkt-dense"

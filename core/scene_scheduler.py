@@ -201,7 +201,11 @@ def run_scenes(
                     return
                 scene = pending.pop(0)
                 state["whole"] += 1
-            future = pool.submit(_run_whole_scene, _picklable(scene), str(out_dir), mode)
+            try:
+                future = pool.submit(_run_whole_scene, _picklable(scene), str(out_dir), mode)
+            except BaseException as exc:  # a broken or shut-down pool: the scene fails, named
+                future = concurrent.futures.Future()
+                future.set_exception(exc)
             future.add_done_callback(lambda f, n=scene.name: whole_done(f, n))
 
     # the pool's processes start before the feeder thread does: a process forked while another

@@ -69,3 +69,20 @@ def test_a_point_mass_saddle_point_is_factored_dense_and_agrees_with_the_sparse_
     (xd, md), (xs, ms) = dense.solve(f, g), sparse.solve(f, g)
     np.testing.assert_allclose(xd, xs, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(md, ms, rtol=1e-12, atol=1e-12)
+
+
+def test_a_singular_saddle_point_is_passed_on_without_a_warning():
+    """[[M, Jᵀ], [J, 0]] singular (a coordinate with neither mass nor constraint): the dense LU's
+    pivots refuse it quietly and the least-squares route answers (warnings are errors here)."""
+    from types import SimpleNamespace
+
+    import core.dynamics as dyn
+
+    M = np.diag([1.0, 0.0])
+    J = np.array([[1.0, 0.0]])
+    owner = SimpleNamespace(_Minv=None, dense=True, minimum_norm=False, _minv_diag=None, mass=lambda t, q: M)
+    fac = dyn._Factor(owner, 0.0, None, J, J, True)
+    assert fac.mode != "kkt-dense"
+    x, mu = fac.solve(np.array([2.0, 0.0]), np.array([0.5]))
+    np.testing.assert_allclose(x[0], 0.5)
+    np.testing.assert_allclose(mu, [1.5])

@@ -102,3 +102,24 @@ def test_the_sweep_scenes_executor_is_the_pools_and_reports_its_processes():
         assert executor_workers(ex) == 3
         assert ex.submit(pow, 2, 5).result() == 32
     assert sorted(counts) == [-1, 1]
+
+
+def test_a_pool_that_refuses_work_fails_the_whole_scenes_and_returns(tmp_path):
+    """A broken pool (here: shut down) fails every whole scene with its reason; nothing hangs."""
+    pool = concurrent.futures.ThreadPoolExecutor(max_workers=2)
+    pool.submit(int).result()
+    real_submit = pool.submit
+    calls = []
+
+    def refuse_scenes(fn, *args, **kwargs):
+        calls.append(fn)
+        if len(calls) > 1:  # the first is the warm-up; then the pool has been "shut down"
+            raise RuntimeError("cannot schedule new futures after shutdown")
+        return real_submit(fn, *args, **kwargs)
+
+    pool.submit = refuse_scenes
+    scenes = [Scene(f"whole-{k}", "whole", "", _whole) for k in range(3)]
+    outcomes = run_scenes(scenes, tmp_path, pool, 2)
+    pool.shutdown()
+    assert [o.ok for o in outcomes] == [False] * 3
+    assert all("cannot schedule new futures" in o.message for o in outcomes)

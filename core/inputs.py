@@ -217,6 +217,9 @@ _SLIP_UNITS: dict[str, tuple[str, ...]] = {
     "rad/s": ("deg/s", "rpm"),
     "1/m": ("1/mm", "1/km"),
     "1": ("percent",),
+    "m^2": ("mm^2", "cm^2"),
+    "m^4": ("mm^4", "cm^4"),
+    "kg/m^3": ("g/cm^3", "t/m^3"),
 }
 
 

@@ -91,6 +91,9 @@ class BeamSection:
     J : torsion constant [m^4]; default ``Iy + Iz`` (a circular section)
     Ip : polar second moment for the rotary inertia of torsion [m^4]; default ``Iy + Iz``
     shear_factor : Timoshenko's shear coefficient kappa [-]; default 5/6 (a rectangle)
+    accept : quantities whose plausible range (``data/core/flexible_plausible_ranges.csv``) is not
+        enforced, e.g. ``("E",)`` for a deliberately soft material; otherwise a value outside is
+        refused with the likely unit slip named
     """
 
     E: float
@@ -103,21 +106,28 @@ class BeamSection:
     J: float | None = None
     Ip: float | None = None
     shear_factor: float = 5.0 / 6.0
+    accept: tuple = ()
 
     def __post_init__(self):
-        units = {"E": "Pa", "rho": "kg/m^3", "A": "m^2", "Iz": "m^4", "Iy": "m^4", "G": "Pa", "nu": "1",
-                 "J": "m^4", "Ip": "m^4", "shear_factor": "1"}
-        for name, unit in units.items():
+        from .ranges import checked
+
+        accept = (self.accept,) if isinstance(self.accept, str) else tuple(self.accept)
+        object.__setattr__(self, "accept", accept)
+        ranged = {"E": "E", "G": "G", "rho": "rho", "A": "A", "Iz": "I", "Iy": "I", "J": "I", "Ip": "I"}
+        for name, quantity in ranged.items():
             value = getattr(self, name)
-            if value is None:
-                continue
-            v = parse_quantity(value, unit, where=f"beam section {name}")
-            if name == "nu":
-                if not -1.0 < v < 0.5:
-                    raise InputError(f"beam section nu = {v!r}: Poisson's ratio must lie in (-1, 0.5)")
-            elif not v > 0.0:
-                raise InputError(f"beam section {name} = {v!r} {unit}: must be positive")
-            object.__setattr__(self, name, v)
+            if value is not None:
+                a = accept + ((quantity,) if name in accept else ())
+                object.__setattr__(self, name, checked(quantity, value, f"beam section {name}", a))
+        nu = parse_quantity(self.nu, "1", where="beam section nu")
+        if not -1.0 < nu < 0.5:
+            raise InputError(f"beam section nu = {nu!r}: Poisson's ratio must lie in (-1, 0.5)")
+        kappa = parse_quantity(self.shear_factor, "1", where="beam section shear_factor")
+        if not 0.0 < kappa <= 1.5:
+            raise InputError(f"beam section shear_factor = {kappa!r}: Timoshenko's coefficient lies in (0, 1.5] "
+                             "(5/6 for a rectangle, about 0.89 for a circle)")
+        object.__setattr__(self, "nu", nu)
+        object.__setattr__(self, "shear_factor", kappa)
         if self.Iy is None:
             object.__setattr__(self, "Iy", self.Iz)
         if self.G is None:
@@ -131,9 +141,10 @@ class BeamSection:
         """A solid rectangle ``width`` (local y) by ``height`` (local z): A = b h, Iz = h b³/12,
         Iy = b h³/12, torsion constant J = β b h³ with Roark's series for the larger side b ≥ h,
         κ = 5/6."""
-        b, h = (parse_quantity(x, "m", where=f"rectangle {n}") for x, n in ((width, "width"), (height, "height")))
-        if not (b > 0 and h > 0):
-            raise InputError(f"rectangle {b!r} m by {h!r} m: both sides must be positive")
+        from .ranges import checked
+
+        b, h = (checked("thickness", x, f"rectangle {n}", kw.get("accept", ()))
+                for x, n in ((width, "width"), (height, "height")))
         long, short = max(b, h), min(b, h)
         # Young & Budynas, Roark's Formulas for Stress and Strain, 7th ed., table 10.7 case 4
         J = long * short**3 * (1.0 / 3.0 - 0.21 * short / long * (1.0 - short**4 / (12.0 * long**4)))
@@ -143,9 +154,9 @@ class BeamSection:
     def circle(cls, E, rho, diameter, **kw) -> BeamSection:
         """A solid circle: A = π d²/4, Iy = Iz = π d⁴/64, J = Ip = π d⁴/32, κ = 6 (1 + ν)/(7 + 6 ν)
         (Cowper 1966)."""
-        d = parse_quantity(diameter, "m", where="circle diameter")
-        if not d > 0:
-            raise InputError(f"circle diameter {d!r} m must be positive")
+        from .ranges import checked
+
+        d = checked("thickness", diameter, "circle diameter", kw.get("accept", ()))
         nu = parse_quantity(kw.get("nu", 0.3), "1", where="beam section nu")
         kw.setdefault("shear_factor", 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu))
         return cls(E=E, rho=rho, A=np.pi * d**2 / 4.0, Iz=np.pi * d**4 / 64.0, **kw)
@@ -207,9 +218,9 @@ def straight_beam(length, n_elements: int, dim: int = 2, start=None, direction=N
                   orientation=(0.0, 0.0, 1.0)) -> BeamMesh:
     """A straight beam of ``n_elements`` equal elements from ``start`` (default the origin) along
     ``direction`` (default x)."""
-    L = parse_quantity(length, "m", where="beam length")
-    if not L > 0:
-        raise InputError(f"beam length {L!r} m must be positive")
+    from .ranges import checked
+
+    L = checked("length", length, "beam length")
     if not (isinstance(n_elements, (int, np.integer)) and n_elements >= 1):
         raise InputError(f"n_elements = {n_elements!r} must be a positive integer")
     if dim not in (2, 3):

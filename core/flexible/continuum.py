@@ -58,14 +58,12 @@ def _shape(mesh) -> str:
     raise InputError(f"the mesh must be a scikit-fem MeshTri, MeshQuad, MeshTet or MeshHex, got {type(mesh).__name__}")
 
 
-def _material(E, nu, rho):
-    E = parse_quantity(E, "Pa", where="Young's modulus E")
-    rho = parse_quantity(rho, "kg/m^3", where="density rho")
+def _material(E, nu, rho, accept=()):
+    from .ranges import checked
+
+    E = checked("E", E, "Young's modulus E", accept)
+    rho = checked("rho", rho, "density rho", accept)
     nu = parse_quantity(nu, "1", where="Poisson's ratio nu")
-    if not E > 0:
-        raise InputError(f"Young's modulus E = {E!r} Pa must be positive")
-    if not rho > 0:
-        raise InputError(f"density rho = {rho!r} kg/m^3 must be positive")
     if not -1.0 < nu < 0.5:
         raise InputError(f"Poisson's ratio nu = {nu!r} must lie in (-1, 0.5)")
     mu = E / (2.0 * (1.0 + nu))
@@ -99,13 +97,15 @@ def _assemble(mesh, order, lam, mu, rho, scale, source) -> FEModel:
     return FEModel(np.ascontiguousarray(locs[::dim]), dim, sp.csr_matrix(M), sp.csr_matrix(K), source)
 
 
-def plane_stress_model(mesh, E, nu, rho, thickness, order: int = 2) -> FEModel:
+def plane_stress_model(mesh, E, nu, rho, thickness, order: int = 2, accept=()) -> FEModel:
     """A plane-stress component of ``thickness`` [m] on a scikit-fem triangle or quadrilateral
-    mesh [m] (module docstring): (u_x, u_y) per node."""
-    E, nu, rho, lam, mu = _material(E, nu, rho)
-    t = parse_quantity(thickness, "m", where="thickness")
-    if not t > 0:
-        raise InputError(f"thickness {t!r} m must be positive")
+    mesh [m] (module docstring): (u_x, u_y) per node.  E, rho and the thickness are checked
+    against their plausible ranges (:mod:`core.flexible.ranges`; ``accept`` names deliberate
+    outliers)."""
+    from .ranges import checked
+
+    E, nu, rho, lam, mu = _material(E, nu, rho, accept)
+    t = checked("thickness", thickness, "thickness", accept)
     _shape(mesh)
     if mesh.p.shape[0] != 2:
         raise InputError(f"plane_stress_model needs a 2-D mesh, got {mesh.p.shape[0]}-D")
@@ -114,10 +114,10 @@ def plane_stress_model(mesh, E, nu, rho, thickness, order: int = 2) -> FEModel:
                      f"plane stress, {type(mesh).__name__} with {mesh.t.shape[1]} elements, order {order}")
 
 
-def solid_model(mesh, E, nu, rho, order: int = 2) -> FEModel:
+def solid_model(mesh, E, nu, rho, order: int = 2, accept=()) -> FEModel:
     """A solid component on a scikit-fem tetrahedron or hexahedron mesh [m] (module docstring):
-    (u_x, u_y, u_z) per node."""
-    E, nu, rho, lam, mu = _material(E, nu, rho)
+    (u_x, u_y, u_z) per node; E and rho checked as in :func:`plane_stress_model`."""
+    E, nu, rho, lam, mu = _material(E, nu, rho, accept)
     _shape(mesh)
     if mesh.p.shape[0] != 3:
         raise InputError(f"solid_model needs a 3-D mesh, got {mesh.p.shape[0]}-D")

@@ -81,7 +81,10 @@ def _check_pair(M, K):
         raise InputError(f"mass {M.shape} and stiffness {K.shape} must be square and of one order")
     for name, A in (("mass", M), ("stiffness", K)):
         if not np.all(np.isfinite(A.data)):
-            raise InputError(f"the {name} matrix has non-finite entries")
+            C = A.tocoo()
+            k = int(np.argmax(~np.isfinite(C.data)))
+            raise InputError(f"the {name} matrix has a non-finite entry {C.data[k]!r} at "
+                             f"({int(C.row[k])}, {int(C.col[k])})")
         asym = abs(A - A.T).max() if A.nnz else 0.0
         if asym > 1e-9 * max(abs(A).max(), 1e-300):
             raise InputError(f"the {name} matrix is not symmetric (largest |A - Aᵀ| = {asym:.3g})")
@@ -105,7 +108,13 @@ def _lowest_modes(K, M, n_modes: int, what: str):
         lam, X = sla.eigh(K.toarray(), M.toarray(), subset_by_index=(0, n_modes - 1))
     else:
         shift = -1e-6 * float(K.diagonal().mean() / M.diagonal().mean())
-        lam, X = spla.eigsh(K.tocsc(), k=n_modes, M=M.tocsc(), sigma=shift, which="LM")
+        try:
+            lam, X = spla.eigsh(K.tocsc(), k=n_modes, M=M.tocsc(), sigma=shift, which="LM")
+        except (spla.ArpackNoConvergence, spla.ArpackError, RuntimeError) as exc:
+            from ..errors import NumericalFailure
+
+            raise NumericalFailure(f"{what}: the sparse eigensolver found no {n_modes} modes of the order-{n} "
+                                   f"problem ({exc})") from None
         order = np.argsort(lam)
         lam, X = lam[order], X[:, order]
         X = X / np.sqrt(np.einsum("ij,ij->j", X, M @ X))[None, :]
@@ -285,8 +294,16 @@ def free_interface(M, K, nodes, dofs_per_node: int, n_modes: int, attachment_dof
     if resid > 1e-8:
         raise ModelError(f"free_interface: the component is not free (|K Φ_r| / |K| = {resid:.2g}: its stiffness "
                          "resists a rigid-body motion); reduce a supported component with craig_bampton")
-    lam, X = _lowest_modes(K, M, n_r + int(n_modes), "free_interface")
-    lam, X = lam[n_r:], X[:, n_r:]  # the elastic ones (the lowest n_r are the rigid-body modes)
+    lam, X = _lowest_modes(K, M, n_r + int(n_modes) + 1 if n_r + int(n_modes) < n else n_r + int(n_modes),
+                           "free_interface")
+    # against the stiffest element's scale (max diag K / diag M bounds the spectrum from about its
+    # top): a relative test on the few modes computed fails when all of them are rigid
+    scale = float(np.max(K.diagonal() / np.where(M.diagonal() > 0, M.diagonal(), np.inf)))
+    zero = lam < RIGID_TOL * max(scale, 1e-300)
+    if zero.sum() > n_r:
+        raise ModelError(f"free_interface: the component has {int(zero.sum())} modes without stiffness, its node "
+                         f"coordinates give {n_r} rigid-body motions: it is a mechanism or in disconnected parts")
+    lam, X = lam[n_r:n_r + int(n_modes)], X[:, n_r:n_r + int(n_modes)]  # the elastic ones
     X = X - R @ (R.T @ (M @ X))  # exactly M-orthogonal to the rigid modes
     MR = M @ R
     shifted = (K + sp.csr_matrix(MR @ MR.T)).tocsc() if n <= DENSE_EIG_MAX else None

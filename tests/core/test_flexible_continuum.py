@@ -72,6 +72,11 @@ def test_careless_continuum_inputs_are_named():
         solid_model(tet, E=E, nu=0.5, rho=RHO)
     with pytest.raises(InputError, match="thickness"):
         plane_stress_model(tri, E=E, nu=NU, rho=RHO, thickness=0.0)
+    with pytest.raises(InputError, match="did you mean 20 mm"):
+        plane_stress_model(tri, E=E, nu=NU, rho=RHO, thickness=20)
+    # 210 read as Pa is refused; which prefix was meant (MPa? GPa?) the range cannot tell
+    with pytest.raises(InputError, match="Young's modulus 210 Pa is outside the plausible range"):
+        solid_model(tet, E=210, nu=NU, rho=RHO)
     with pytest.raises(InputError, match="MeshTri"):
         plane_stress_model(object(), E=E, nu=NU, rho=RHO, thickness=T)
     with pytest.raises(InputError, match="order"):

@@ -13,6 +13,7 @@ HERE = Path(__file__).resolve().parent
 RUNS = [
     ["railway_contact_speed.py"],
     ["railway_creep_speed.py"],
+    ["main_job_speedups.py"],
     ["peer_chain.py", "--quick"],
 ]
 

@@ -180,6 +180,7 @@ class ModelBuilder:
         self.extras: OrderedDict[str, ExtraCoordinate] = OrderedDict()
         self.joints: OrderedDict[str, Joint | UserConstraint] = OrderedDict()
         self.forces: OrderedDict[str, ForceElement] = OrderedDict()
+        self.flexible: OrderedDict[str, tuple] = OrderedDict()  # name -> (data, modal names, node constraint)
 
     # --- names ------------------------------------------------------------------------------
     def _check_new(self, name: str, what: str) -> None:
@@ -242,6 +243,113 @@ class ModelBuilder:
                 raise ModelError(f"body {name!r}: angular velocity must be 3 finite numbers")
             body = Body(name, float(mass), J, pos, p / np.linalg.norm(p), vel, om)
         self.bodies[name] = body
+        return name
+
+    def add_flexible_body(self, name: str, fe_model, modes, position=None, orientation=None, velocity=None,
+                          angular_velocity=None, modal_coordinates=None, modal_velocities=None,
+                          damping_ratio=0.0, geometric_stiffening: bool = False) -> str:
+        """Add a flexible body: a floating frame of reference with the modes of a reduced FE component
+        (:mod:`core.flexible.body`).
+
+        Parameters
+        ----------
+        fe_model : core.flexible.FEModel
+            The component; its node coordinates define the body frame (origin and axes).
+        modes : core.flexible.ModalComponent
+            The reduction basis (cantilever modes from ``normal_mode_component`` with the clamp held,
+            ``craig_bampton`` or ``free_interface`` with ``orthonormalized(drop_rigid=True)``); a basis
+            holding rigid-body modes is refused.
+        position, orientation, velocity, angular_velocity
+            Of the body frame, as for :meth:`add_body`.
+        modal_coordinates, modal_velocities : array_like, shape (n_modes,)
+            Initial modal coordinates and rates (default 0).
+        damping_ratio : float, str or array_like
+            Modal damping ratio ζ (``0.02`` or ``"2 %"``), one for all modes or one per mode.
+        geometric_stiffening : bool
+            Add the centrifugal geometric stiffness (needed for fast-spinning slender bodies).
+
+        Returns
+        -------
+        str
+            ``name``; the modal coordinates are extra coordinates ``name.q1 …``; attach joints and
+            forces to nodes with :meth:`add_node_frame`, or to ``name`` itself (the frame).
+        """
+        from .flexible.body import flexible_body_data
+
+        self._check_new(name, "body")
+        data = flexible_body_data(name, fe_model, modes, damping_ratio, geometric_stiffening, self.space.dim)
+        m = data.n_modes
+        q0 = np.zeros(m) if modal_coordinates is None else np.asarray(modal_coordinates, float)
+        qd0 = np.zeros(m) if modal_velocities is None else np.asarray(modal_velocities, float)
+        for label, arr in (("modal_coordinates", q0), ("modal_velocities", qd0)):
+            if arr.shape != (m,) or not np.all(np.isfinite(arr)):
+                raise ModelError(f"flexible body {name!r}: {label} must be {m} finite numbers (one per mode), "
+                                 f"got shape {arr.shape}")
+        d = self.space.dim
+        self.add_body(name, 0.0, 0.0 if d == 2 else np.zeros((3, 3)), np.zeros(d) if position is None else position,
+                      orientation, velocity, angular_velocity)
+        names = []
+        for k in range(m):
+            cname = f"{name}.q{k + 1}"
+            self._check_new(cname, "coordinate")
+            self.extras[cname] = ExtraCoordinate(cname, float(q0[k]), float(qd0[k]), 0.0)
+            names.append(cname)
+        self.flexible[name] = (data, names, None)
+        return name
+
+    def add_node_frame(self, body: str, node: int, name: str | None = None) -> str:
+        """A frame on node ``node`` of flexible body ``body`` that joints, forces and drivers attach to.
+
+        The frame is a massless body held at the node's deformed position and orientation by the
+        constraint ``body.nodes`` (:class:`core.flexible.body.FlexibleNodes`); its axes are the body
+        frame's axes when undeformed, so give joint axes and points in the flexible body's coordinates
+        (the node's position is the frame's origin).  Default name ``f"{body}.node{node}"``.
+        """
+        from .flexible.body import FlexibleNodes
+
+        if body not in self.flexible:
+            what = "a rigid body: attach to it directly" if body in self.bodies else "not a body of this model"
+            known = ", ".join(self.flexible) or "none"
+            raise ModelError(f"add_node_frame: {body!r} is {what} (flexible bodies: {known})")
+        data, names, nodes = self.flexible[body]
+        N = data.nodes.shape[0]
+        if not (isinstance(node, (int, np.integer)) and 0 <= node < N):
+            raise ModelError(f"add_node_frame: flexible body {body!r} has nodes 0..{N - 1}, got {node!r}")
+        name = f"{body}.node{int(node)}" if name is None else name
+        fb = self.bodies[body]
+        q = np.array([self.extras[c].value for c in names])
+        qd = np.array([self.extras[c].rate for c in names])
+        s = data.nodes[node] + data.translation_rows(node) @ q
+        sd = data.translation_rows(node) @ qd
+        psi, psid = data.rotation_rows(node) @ q, data.rotation_rows(node) @ qd
+        if self.space.dim == 2:
+            A = frames.rot2(fb.orientation)
+            w = float(fb.angular_velocity)
+            pos = fb.position + A @ s
+            vel = fb.velocity + A @ (w * (frames.ROT90 @ s) + sd)
+            self.add_body(name, 0.0, 0.0, pos, fb.orientation + float(psi[0]), vel, w + float(psid[0]))
+        else:
+            A = frames.euler_to_matrix(fb.orientation)
+            wb = A.T @ fb.angular_velocity
+            sn = float(np.linalg.norm(psi))
+            if sn >= 1.0:
+                raise ModelError(f"add_node_frame: node {node} of {body!r} is rotated by {sn:.3g} rad by the initial "
+                                 "modal coordinates; a linear floating frame needs small rotations")
+            ang = np.arcsin(sn)
+            Crel = frames.euler_to_matrix(frames.rotation_vector_to_euler(psi / sn * ang if sn > 0 else psi))
+            AN = A @ Crel
+            # ½(tr C I − Cᵀ) ω̄_N = ½(tr C I − C) ω̄ + Ψ q̇ (the rate of the orientation constraint)
+            tr = np.trace(Crel) * np.eye(3)
+            wN = np.linalg.solve(0.5 * (tr - Crel.T), 0.5 * (tr - Crel) @ wb + psid)
+            pos = fb.position + A @ s
+            vel = fb.velocity + A @ (np.cross(wb, s) + sd)
+            self.add_body(name, 0.0, np.zeros((3, 3)), pos, frames.matrix_to_euler(AN), vel, AN @ wN)
+        if nodes is None:
+            nodes = FlexibleNodes(data, names)
+            self.flexible[body] = (data, names, nodes)
+            self._check_new(nodes.name, "joint")
+            self.joints[nodes.name] = nodes
+        nodes.add(name, int(node))
         return name
 
     def add_coordinate(self, name: str, value: float, rate: float = 0.0, mass: float = 0.0) -> str:
@@ -426,6 +534,16 @@ class ModelBuilder:
         return model
 
 
+@dataclass(frozen=True)
+class _FlexRecord:
+    """A flexible body in a model: its data, body index and coordinate/velocity indices."""
+
+    data: object
+    body: int
+    qi: NDArray[np.int64]
+    vi: NDArray[np.int64]
+
+
 class Model(ConstrainedSystem):
     """Frozen Cartesian multibody model (see module docstring). Create with :class:`ModelBuilder`.
 
@@ -503,6 +621,7 @@ class Model(ConstrainedSystem):
         blocks += [np.array([[ex.mass]]) for ex in b.extras.values()]
         self._M = sp.block_diag(blocks, format="csr") if blocks else sp.csr_matrix((0, 0))
         self.mass_is_constant = True
+        self._setup_flexible(b)
         self._masses = np.array([bd.mass for bd in bodies])
         self._J = np.array([bd.inertia for bd in bodies]) if sp_.dim == 3 else None
         # constant gravity force --------------------------------------------------------------
@@ -612,7 +731,8 @@ class Model(ConstrainedSystem):
         self.force_kinds: list[ForceKind] = [cls_.compile(els, ctx) for cls_, els in fgroups.items()]
         self.time_dependent = (any(k.time_dependent for k in self.kinds)
                                or any(getattr(uc, "time_dependent", False) for uc in self.user_constraints))
-        self.is_conservative = all(fk.conservative for fk in self.force_kinds) and not self.time_dependent
+        self.is_conservative = (all(fk.conservative for fk in self.force_kinds) and not self.time_dependent
+                                and all(f.data.conservative for f in self.flexible))
         self._reaction_points = {}
         for j in self.joints:
             if isinstance(j, UserConstraint):
@@ -621,6 +741,47 @@ class Model(ConstrainedSystem):
             kb = ctx.index(bj_name, j.name)
             self._reaction_points[j.name] = (kb, ctx.local_point(kb, j.report_point(ctx)))
         return self
+
+    def _setup_flexible(self, b: ModelBuilder) -> None:
+        """Index the flexible bodies' blocks and fix the sparse pattern of ``M(q)`` (:mod:`core.flexible.body`)."""
+        sp_, nb = self.space, self.n_bodies
+        recs = []
+        for name, (data, names, _) in b.flexible.items():
+            k = self.body_names.index(name)
+            ex = np.array([self.extra_names.index(c) for c in names], np.int64)
+            vi = np.concatenate([k * sp_.n_v + np.arange(sp_.n_v), nb * sp_.n_v + ex])
+            qi = np.concatenate([k * sp_.n_q + np.arange(sp_.n_q), nb * sp_.n_q + ex])
+            recs.append(_FlexRecord(data, k, qi, vi))
+        self.flexible = tuple(recs)
+        if not recs:
+            return
+        self.mass_is_constant = False
+        pattern = abs(self._M).tocoo()
+        rows = [pattern.row] + [np.repeat(f.vi, len(f.vi)) for f in recs]
+        cols = [pattern.col] + [np.tile(f.vi, len(f.vi)) for f in recs]
+        P = sp.csr_matrix((np.ones(sum(len(r) for r in rows)), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=self._M.shape)
+        P.sum_duplicates()
+        P.sort_indices()
+        pos = sp.csr_matrix((np.arange(P.nnz, dtype=float) + 1.0, P.indices, P.indptr), shape=P.shape)
+        self._M_pattern = (P.indices.copy(), P.indptr.copy())
+        base = self._M.tocoo()
+        self._M_base = np.zeros(P.nnz)
+        np.add.at(self._M_base, np.asarray(pos[base.row, base.col]).ravel().astype(np.int64) - 1, base.data)
+        self._M_flex_pos = [np.asarray(pos[np.repeat(f.vi, len(f.vi)), np.tile(f.vi, len(f.vi))]).ravel().astype(np.int64) - 1
+                            for f in recs]
+
+    def _flexible_terms(self, q: Array, v: Array | None, want_M: bool = True):
+        """Per flexible body ``(M_b, Q_b)`` at ``(q, v)`` (v None: zero velocities)."""
+        out = []
+        d = self.space.dim
+        for f in self.flexible:
+            qb = q[f.qi]
+            vb = np.zeros(len(f.vi)) if v is None else v[f.vi]
+            nqb, nvb = self.space.n_q, self.space.n_v
+            A = self.space.rotation(qb[None, :nqb])[0]
+            out.append(f.data.mass_and_forces(A, vb[:d], vb[d:nvb], qb[nqb:], vb[nvb:], self.gravity))
+        return out
 
     # --- picklability is automatic (plain attributes; time functions must be picklable) --------
 
@@ -718,7 +879,12 @@ class Model(ConstrainedSystem):
 
     # --- dynamics ----------------------------------------------------------------------------
     def M(self, t: float, q: Array):
-        return self._M
+        if not self.flexible:
+            return self._M
+        data = self._M_base.copy()
+        for (Mb, _), pos in zip(self._flexible_terms(q, None), self._M_flex_pos):
+            np.add.at(data, pos, Mb.ravel())
+        return _make_csr(data, *self._M_pattern, self._M.shape)
 
     def _force_accumulate(self, bs: BodyStates, t: float) -> Array:
         """Sum of every force kind's generalized forces, shape (n_v,) (gravity and gyroscopic excluded)."""
@@ -742,7 +908,45 @@ class Model(ConstrainedSystem):
         if self.force_kinds:
             bs = self.body_states(q, v)
             Q += self._force_accumulate(bs, t)
+        for f, (_, Qb) in zip(self.flexible, self._flexible_terms(q, v)):
+            Q[f.vi] += Qb
         return Q
+
+    def _flexible_jacobian_entries(self, q, v):
+        """Rows, columns and values of ∂Q/∂q and ∂Q/∂v of the flexible bodies' forces (forward
+        differences over each body's own coordinates: 3–6 + n_modes columns)."""
+        out = []
+        nqb, nvb, d = self.space.n_q, self.space.n_v, self.space.dim
+        for f in self.flexible:
+            qb, vb = q[f.qi].copy(), v[f.vi].copy()
+
+            def Qb(qq, vv, f=f):
+                A = self.space.rotation(qq[None, :nqb])[0]
+                return f.data.mass_and_forces(A, vv[:d], vv[d:nvb], qq[nqb:], vv[nvb:], self.gravity)[1]
+
+            Q0 = Qb(qb, vb)
+            n = len(f.vi)
+            Jq, Jv = np.zeros((n, n)), np.zeros((n, n))
+            for k in range(d, n):  # Q_b does not depend on the frame position
+                h = 1e-7 * max(1.0, abs(vb[k]))
+                vv = vb.copy()
+                vv[k] += h
+                Jv[:, k] = (Qb(qb, vv) - Q0) / h
+                h = 1e-7
+                dv = np.zeros(nvb)
+                qq = qb.copy()
+                if k < nvb:
+                    dv[k] = h
+                    if d == 2:
+                        qq[2] += h
+                    else:
+                        qq[3:7] = frames.quat_multiply(qb[3:7], frames.rotation_vector_to_euler(dv[3:6]))
+                else:
+                    qq[nqb + k - nvb] += h
+                Jq[:, k] = (Qb(qq, vb) - Q0) / h
+            r_, c_ = np.repeat(f.vi, n), np.tile(f.vi, n)
+            out.append((r_, c_, Jq.ravel(), Jv.ravel()))
+        return out
 
     # --- search state of stateful force kinds (see core.forces.protocol) -----------------------
     @property
@@ -786,6 +990,11 @@ class Model(ConstrainedSystem):
                 extra_j.append(ej)
                 extra_q.append(eq)
                 extra_v.append(ev)
+        for ei, ej, eq, ev in self._flexible_jacobian_entries(q, v):
+            extra_i.append(ei)
+            extra_j.append(ej)
+            extra_q.append(eq)
+            extra_v.append(ev)
         if self.space.dim == 3 and nb:
             w = v[: nb * 6].reshape(nb, 6)[:, 3:]
             Jw = np.einsum("nij,nj->ni", self._J, w)
@@ -797,9 +1006,13 @@ class Model(ConstrainedSystem):
             Kq.append(np.zeros((nb, 6, 6)))
             Kv.append(G)
         shape = (self.n_v, self.n_v)
-        if not rows:
+        if not rows and not extra_i:
             Z = sp.csr_matrix(shape)
             return Z, Z
+        if not rows:
+            ii, jj = np.concatenate(extra_i), np.concatenate(extra_j)
+            return (sp.csr_matrix((np.concatenate(extra_q), (ii, jj)), shape=shape),
+                    sp.csr_matrix((np.concatenate(extra_v), (ii, jj)), shape=shape))
         r = np.concatenate(rows)
         c = np.concatenate(cols)
         keep = (r < nb) & (c < nb)
@@ -893,10 +1106,14 @@ class Model(ConstrainedSystem):
 
     # --- energy and reactions ------------------------------------------------------------------
     def energy(self, t: float, q: Array, v: Array) -> float:
-        T = 0.5 * float(v @ (self._M @ v))
+        T = 0.5 * float(v @ (self.M(t, q) @ v))
         nb = self.n_bodies
         r = q[: nb * self.space.n_q].reshape(nb, self.space.n_q)[:, : self.space.dim]
         V = -float(np.sum(self._masses * (r @ self.gravity)))
+        for f in self.flexible:
+            qb = q[f.qi]
+            A = self.space.rotation(qb[None, :self.space.n_q])[0]
+            V += f.data.potential(qb[:self.space.dim], A, qb[self.space.n_q:], self.gravity)
         if self.force_kinds:
             bs = self.body_states(q, v)
             V += sum(fk.potential(bs) for fk in self.force_kinds)

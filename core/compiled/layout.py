@@ -327,6 +327,10 @@ def _compile(model) -> CompiledModel:
         raise NotCompilable(f"model {model.name!r} keeps redundant constraint rows "
                             f"({', '.join(model.redundant_constraints[:3])}...); build it with redundant='remove' "
                             "for the compiled integrators (their Schur complement must be positive definite)")
+    if getattr(model, "flexible", ()):
+        names = ", ".join(f.data.name for f in model.flexible)
+        raise NotCompilable(f"model {model.name!r} has flexible bodies ({names}): their configuration-dependent mass "
+                            "matrix has no compiled form yet; use the numpy integrators")
     layout = Layout(model)
     sp_ = model.space
     nb, dim, nvb = model.n_bodies, sp_.dim, sp_.n_v

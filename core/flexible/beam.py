@@ -69,7 +69,8 @@ import scipy.sparse as sp
 from ..errors import InputError
 from ..inputs import parse_quantity
 
-__all__ = ["BeamMesh", "BeamSection", "beam_matrices", "straight_beam", "THEORIES"]
+__all__ = ["BeamGeometricStiffness", "BeamMesh", "BeamSection", "beam_matrices", "geometric_stiffness",
+           "straight_beam", "THEORIES"]
 
 THEORIES = ("euler-bernoulli", "timoshenko")
 
@@ -349,3 +350,73 @@ def beam_matrices(mesh: BeamMesh, section: BeamSection, theory: str = "euler-ber
     K = sp.csr_matrix((np.concatenate(kv), (rows, cols)), shape=shape)
     M = sp.csr_matrix((np.concatenate(mv), (rows, cols)), shape=shape)
     return M, K
+
+
+def _geometric_bending(L):
+    """Consistent geometric stiffness of a bending element per unit axial force, on
+    (v_i, θ_i, v_j, θ_j) (Przemieniecki 1968, eq. 15.33; cubic Hermite shape functions)."""
+    return 1.0 / (30.0 * L) * np.array([[36.0, 3 * L, -36.0, 3 * L],
+                                        [3 * L, 4 * L**2, -3 * L, -L**2],
+                                        [-36.0, -3 * L, 36.0, -3 * L],
+                                        [3 * L, -L**2, -3 * L, 4 * L**2]])
+
+
+def geometric_stiffness(mesh: BeamMesh, section: BeamSection, u) -> sp.csr_matrix:
+    r"""Geometric (stress) stiffness of the mesh in the axial-force state of the displacement ``u``.
+
+    Each element's axial force :math:`N_e = EA\,(u_j - u_i)\cdot e_x / L` multiplies its consistent
+    geometric stiffness :math:`N_e/(30L)\,[36, 3L, -36, 3L; \dots]` in both bending planes
+    (Przemieniecki 1968, eq. 15.33), so that :math:`(K + K_G(u))` is the tangent stiffness of a beam
+    pre-stressed by :math:`u`.  Tension (:math:`N > 0`) stiffens.  The torsional term
+    :math:`N I_p / (A L)` is left out (second order for slender beams).
+
+    Parameters
+    ----------
+    u : (n_dofs,) array
+        Nodal displacements [m, rad] in the mesh's global axes.
+    """
+    u = np.asarray(u, float).reshape(mesh.n_dofs)
+    n = mesh.dofs_per_node
+    rows, cols, vals = [], [], []
+    for e in range(mesh.elements.shape[0]):
+        L, R = _local_axes(mesh, e)
+        i, j = mesh.elements[e]
+        d = mesh.dim
+        N = section.E * section.A * float(R[0] @ (u[j * n:j * n + d] - u[i * n:i * n + d])) / L
+        Gb = N * _geometric_bending(L)
+        if d == 2:
+            Kl = np.zeros((6, 6))
+            bd = [1, 2, 4, 5]
+            Kl[np.ix_(bd, bd)] = Gb
+            T = np.zeros((6, 6))
+            for k in (0, 3):
+                T[k:k + 2, k:k + 2] = R
+                T[k + 2, k + 2] = 1.0
+        else:
+            Kl = np.zeros((12, 12))
+            Kl[np.ix_([1, 5, 7, 11], [1, 5, 7, 11])] = Gb
+            S = np.diag([1.0, -1.0, 1.0, -1.0])
+            Kl[np.ix_([2, 4, 8, 10], [2, 4, 8, 10])] = S @ Gb @ S
+            T = np.zeros((12, 12))
+            for k in range(4):
+                T[3 * k:3 * k + 3, 3 * k:3 * k + 3] = R
+        Ke = T.T @ Kl @ T
+        idx = np.concatenate([np.arange(n) + i * n, np.arange(n) + j * n])
+        r, c = np.meshgrid(idx, idx, indexing="ij")
+        rows.append(r.ravel())
+        cols.append(c.ravel())
+        vals.append(Ke.ravel())
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(mesh.n_dofs, mesh.n_dofs))
+
+
+@dataclass(frozen=True)
+class BeamGeometricStiffness:
+    """``K_G(u)`` of a beam mesh (:func:`geometric_stiffness`) as a picklable callable, the form in
+    which an :class:`~core.flexible.fe_model.FEModel` offers its stress stiffening."""
+
+    mesh: BeamMesh
+    section: BeamSection
+
+    def __call__(self, u) -> sp.csr_matrix:
+        return geometric_stiffness(self.mesh, self.section, u)

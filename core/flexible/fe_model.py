@@ -28,13 +28,19 @@ MAX_EXTENT = 500.0
 @dataclass(frozen=True)
 class FEModel:
     """Nodes (N, dim) [m], ``dofs_per_node``, mass and stiffness (scipy CSR) of order
-    ``N * dofs_per_node``, and ``source`` (what it was made from)."""
+    ``N * dofs_per_node``, and ``source`` (what it was made from).
+
+    ``geometric_stiffness``, where the element type provides one, is a callable ``u -> K_G(u)``:
+    the stress stiffness in the stress state of the displacement ``u`` (beams:
+    :class:`~core.flexible.beam.BeamGeometricStiffness`); flexible bodies use it for geometric
+    stiffening.  Imported matrices have none."""
 
     nodes: np.ndarray
     dofs_per_node: int
     M: sp.csr_matrix
     K: sp.csr_matrix
     source: str = ""
+    geometric_stiffness: object = None
 
     def __post_init__(self):
         n = self.nodes.shape[0] * self.dofs_per_node
@@ -57,10 +63,11 @@ class FEModel:
     @classmethod
     def from_beam(cls, mesh, section, theory: str = "euler-bernoulli") -> FEModel:
         """The beam elements' assembled matrices (:func:`core.flexible.beam.beam_matrices`)."""
-        from .beam import beam_matrices
+        from .beam import BeamGeometricStiffness, beam_matrices
 
         M, K = beam_matrices(mesh, section, theory)
-        return cls(mesh.nodes, mesh.dofs_per_node, M, K, f"{theory} beam, {mesh.elements.shape[0]} elements")
+        return cls(mesh.nodes, mesh.dofs_per_node, M, K, f"{theory} beam, {mesh.elements.shape[0]} elements",
+                   BeamGeometricStiffness(mesh, section))
 
     @classmethod
     def read(cls, mass, stiffness, nodes, dofs_per_node: int, length_unit: str = "m",

@@ -143,6 +143,17 @@ def normal_modes(M, K, n_modes: int, fixed_dofs=()):
     return np.sqrt(np.clip(lam, 0.0, None)) / (2.0 * np.pi), shapes
 
 
+def normal_mode_component(M, K, n_modes: int, fixed_dofs=()) -> ModalComponent:
+    """The lowest ``n_modes`` normal modes with ``fixed_dofs`` held, as a :class:`ModalComponent`
+    (mass-normalised; zero rows at the fixed degrees of freedom).  With the nodes of a clamp held,
+    these are the cantilever modes of a floating frame attached to that clamp."""
+    M, K = _check_pair(M, K)
+    f, X = normal_modes(M, K, n_modes, fixed_dofs)
+    Mr, Kr = X.T @ (M @ X), X.T @ (K @ X)
+    return ModalComponent(X, 0.5 * (Mr + Mr.T), 0.5 * (Kr + Kr.T), tuple(f"mode {k + 1}" for k in range(X.shape[1])),
+                          f, np.zeros(0, np.int64), "normal modes" + (", supported" if len(fixed_dofs) else ""))
+
+
 @dataclass(frozen=True)
 class ModalComponent:
     """A reduced linear elastic component, :math:`u = T q`.

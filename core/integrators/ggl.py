@@ -69,6 +69,7 @@ import scipy.sparse.linalg as spla
 
 from ..dynamics import accelerations, constraint_terms
 from ..frames import skew
+from ..system import as_dense
 from .base import IntegrationFailure, Integrator, register
 from .generalized_alpha import ConstraintCurvature, _sparse, q_jacobians, q_magnitude, rmatvec
 
@@ -177,7 +178,7 @@ class RadauGGL(Integrator):
         if self._M_const is not None:
             M = self._M_const
         else:
-            self._Mn = np.asarray(self.system.M(t, q), float)
+            self._Mn = as_dense(self.system.M(t, q))
             M = _sparse(self._Mn)
         return sp.block_diag([sp.identity(nv, format="csr"), M, sp.csr_matrix((2 * nc, 2 * nc))], format="csc")
 
@@ -250,13 +251,13 @@ class RadauGGL(Integrator):
         """``∂(M(t, q ⊕ X) a)/∂X`` at ``X = 0`` by forward differences, shape (n_v, n_v)."""
         sys_ = self.system
         nv = self.nv
-        Ma = np.asarray(sys_.M(t, q), float) @ a
+        Ma = as_dense(sys_.M(t, q)) @ a
         D = np.empty((nv, nv))
         for k in range(nv):  # Jacobian evaluations only, for systems with a non-constant M
             dv = np.zeros(nv)
             h = eps * max(1.0, abs(q[k]) if sys_.n_q == nv else 1.0)
             dv[k] = h
-            D[:, k] = (np.asarray(sys_.M(t, sys_.retract(q, dv)), float) @ a - Ma) / h
+            D[:, k] = (as_dense(sys_.M(t, sys_.retract(q, dv))) @ a - Ma) / h
         self.counters["n_rhs"] += nv
         return D
 
@@ -300,7 +301,7 @@ class RadauGGL(Integrator):
                 Mn = self._Mn
                 for i in range(3):
                     qi = self.system.retract(qn, Z[i, :self.nv])
-                    F[i, self.nv:nd] -= (self.system.M(t + ch[i], qi) - Mn) @ Vd[i]
+                    F[i, self.nv:nd] -= (as_dense(self.system.M(t + ch[i], qi)) - Mn) @ Vd[i]
             if not np.all(np.isfinite(F)):
                 break
             f_real = F.T.dot(TI_REAL) - M_real * (Mbig @ W[0])

@@ -25,6 +25,10 @@ SCENES = [
                   "Rebound heights vs e²."),
     example_scene("andrews", "core/andrews.py", "Andrews' squeezer (seven angles) vs published reference",
                   "Hairer & Wanner II §VII.7; Test Set for IVP Solvers."),
+    example_scene("flexible-spin-up-beam", "core/flexible_spin_up_beam.py",
+                  "Spin-up beam: flexible body with and without geometric stiffening",
+                  "Kane, Ryan & Banerjee (1987); floating frame with cantilever modes against a geometrically exact "
+                  "rigid-link chain.", full_adds="chains of 20 and 40 links as the reference."),
     # the work-precision report is part of the main job (``make run``)
     example_scene("work-precision", "core/work_precision.py",
                   "Work-precision: error against run time for every integrator",

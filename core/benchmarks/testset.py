@@ -36,7 +36,7 @@ from ..system import ConstrainedSystem
 
 Array = NDArray[np.float64]
 
-__all__ = ["AndrewsSqueezer", "CarAxis", "ANDREWS_PARAMETERS"]
+__all__ = ["AndrewsSqueezer", "CarAxis", "SimeonCrank", "ANDREWS_PARAMETERS", "SIMEON_CRANK_PARAMETERS"]
 
 
 #: Parameters of Andrews' squeezing mechanism, SI units (Hairer & Wanner 1996, Table 7.1;
@@ -445,3 +445,198 @@ class CarAxis(ConstrainedSystem):
 
     def reaction_groups(self) -> dict[str, NDArray[np.int64]]:
         return {"wheel contact": np.array([0]), "axis length": np.array([1])}
+
+
+
+#: Parameters of Simeon's slider crank with an elastic rod (test set ``crank.f``, ``RESMBS``):
+#: masses [kg], lengths [m], inertias [kg m²], E [Pa], rod section BB × HH [m], ρ [kg/m³], Ω [rad/s].
+#: PI is the code's truncated π, which enters the stiffness and coupling terms.
+SIMEON_CRANK_PARAMETERS: dict[str, float] = dict(
+    M1=0.36, M2=0.151104, M3=0.075552, L1=0.15, L2=0.30, J1=0.002727, J2=0.0045339259,
+    EE=0.20e12, BB=0.008, HH=0.008, RHO=7870.0, GRAV=0.0, OMEGA=150.0, PI=3.1415927,
+)
+
+
+class SimeonCrank(ConstrainedSystem):
+    r"""Slider crank with an elastic connecting rod, as published (Simeon 1996; test set "crank").
+
+    Coordinates ``p = (φ₁, φ₂, x₃, q₁, q₂, q₃, q₄)``: crank angle, rod angle, slider position and
+    the rod's deformation in a frame attached at the crank pin with its x axis through the rod's
+    other end; lateral ``v(ξ) = q₁ sin πξ + q₂ sin 2πξ``, axial ``u(ξ) = q₃ 4ξ(1−ξ) + q₄ ξ(2ξ−1)``
+    (ξ = s/L₂).  The midpoint deflection in that frame is ``q₁``.  Mass matrix, forces (with
+    the quadratic-velocity terms) and constraints exactly as in the test set's ``RESMBS`` (Simeon,
+    18.2.98; test set release 2.4), with its options: ``stiffness="linear"`` (the reference) or
+    ``"nonlinear"`` (its geometric stiffness term), ``damping`` off or on (its "0.5 %" matrix).
+
+    Constraints (index 3; the test set integrates the index-2 form)::
+
+        Φ = [L₁ sin φ₁ + (L₂ + q₄) sin φ₂,
+             x₃ − L₁ cos φ₁ − (L₂ + q₄) cos φ₂,
+             φ₁ − Ω t]
+
+    **The axial mass block.** The published code sets it to ``ρBHL₂ [[8, 1], [1, 2]]``, fifteen
+    times the consistent mass of its quadratic shape functions (∫N₃² = 8/15, ∫N₃N₄ = 1/15,
+    ∫N₄² = 2/15); the published initial values and reference solution are consistent only with the
+    block as coded, so ``axial_mass="published"`` (default) reproduces the test set and
+    ``axial_mass="consistent"`` divides it by 15.
+
+    Initial values: ``initial="smooth"`` (the test set's set 1, "close to smooth motion", with the
+    refined digits that reproduce its reference) or ``"rigid"`` (set 2: rod straight and
+    undeformed, rigid-mechanism velocities).  Reference at t = 0.1 s (:attr:`reference`): the test
+    set's ``cranksoln`` (MEBDFI, rtol = atol = 1e-14; set 1, linear stiffness, no damping).
+
+    References
+    ----------
+    B. Simeon, "Modelling a flexible slider crank mechanism by a mixed system of DAEs and PDEs",
+    Math. Modelling of Systems 2 (1996) 1–18; F. Mazzia, C. Magherini, Test Set for IVP Solvers,
+    release 2.4, 2008, problem "crank" (``crank.f``: ``RESMBS``, ``init``, ``init2``,
+    ``cranksoln``), as distributed with the R package deTestSet (``src/Ex_crank.f``).
+    """
+
+    name = "simeon_crank"
+    n_q = n_v = 7
+    n_c = 3
+    mass_is_constant = False
+    is_conservative = False
+    coordinate_names = ["phi1 [rad]", "phi2 [rad]", "x3 [m]", "q1 [m]", "q2 [m]", "q3 [m]", "q4 [m]"]
+    velocity_names = ["phi1_dot [rad/s]", "phi2_dot [rad/s]", "x3_dot [m/s]", "q1_dot [m/s]", "q2_dot [m/s]",
+                      "q3_dot [m/s]", "q4_dot [m/s]"]
+    constraint_names = ["rod end on the slider axis (y)", "rod end at the slider (x)", "crank drive"]
+
+    #: set 1 with the refined digits (they reproduce ``cranksoln``; the 9-digit values of ``init``
+    #: move q₁(0.1) by about 2e-8 relative)
+    SMOOTH = dict(
+        q=np.array([0.0, 0.0, 4.500169330000000e-01, 0.0, 0.0, 1.033398630000000e-05, 1.693279690000000e-05]),
+        v=np.array([1.500000000000000e+02, -7.499576703969453e+01, -2.689386719979040e-06, 4.448961125815990e-01,
+                    4.634339319238670e-03, -1.785910760000550e-06, -2.689386719979040e-06]),
+    )
+    #: set 2 (``init2``): on the rigid motion, rod undeformed
+    RIGID = dict(q=np.array([0.0, 0.0, 0.45, 0.0, 0.0, 0.0, 0.0]),
+                 v=np.array([150.0, -75.0, 0.0, 0.0, 0.0, 0.0, 0.0]))
+
+    #: published solution at t = 0.1 s (set 1, linear stiffness, no damping, axial mass as published)
+    reference = dict(
+        t=0.1,
+        q=np.array([0.1500000000000104e+02, -0.3311734988256260e+00, 0.1697373328427860e+00,
+                    0.1893192899613509e-03, 0.2375751249879174e-04, -0.5323896770569702e-05,
+                    -0.8363313279112129e-05]),
+        v=np.array([0.1500000000000000e+03, 0.6025346755138369e+02, -0.8753116326670527e+01,
+                    -0.3005541400289738e-01, -0.5500431812571696e-02, 0.4974111734266989e-03,
+                    0.1105560003626645e-02]),
+        lam=np.array([-0.6232935833287916e+02, -0.1637920993367306e+03, 0.2529857947066878e+02]),
+        source=("Mazzia & Magherini, Test Set for IVP Solvers, crank.f, subroutine cranksoln (MEBDFI, "
+                "rtol = atol = 1e-14), as in deTestSet src/Ex_crank.f"),
+    )
+
+    def __init__(self, initial: str = "smooth", stiffness: str = "linear", damping: bool = False,
+                 axial_mass: str = "published", **overrides: float):
+        if initial not in ("smooth", "rigid"):
+            raise ValueError(f"SimeonCrank: initial must be 'smooth' (set 1) or 'rigid' (set 2), got {initial!r}")
+        if stiffness not in ("linear", "nonlinear"):
+            raise ValueError(f"SimeonCrank: stiffness must be 'linear' or 'nonlinear', got {stiffness!r}")
+        if axial_mass not in ("published", "consistent"):
+            raise ValueError(f"SimeonCrank: axial_mass must be 'published' or 'consistent', got {axial_mass!r}")
+        unknown = set(overrides) - set(SIMEON_CRANK_PARAMETERS)
+        if unknown:
+            raise ValueError(f"SimeonCrank: unknown parameter(s) {sorted(unknown)}")
+        self.p = p = dict(SIMEON_CRANK_PARAMETERS, **{k: float(v) for k, v in overrides.items()})
+        self.nonlinear, self.damping = stiffness == "nonlinear", bool(damping)
+        start = self.SMOOTH if initial == "smooth" else self.RIGID
+        self.q0, self.v0 = start["q"].copy(), start["v"].copy()
+        PI, L2 = p["PI"], p["L2"]
+        # the published x₃ is rounded to 9 digits (2e-10 m off the loop closure, which an index-2/3
+        # integrator must satisfy exactly): take it from the closure
+        self.q0[2] = p["L1"] * np.cos(self.q0[0]) + (L2 + self.q0[6]) * np.cos(self.q0[1])
+        facm, fack, facb = p["RHO"] * p["BB"] * p["HH"] * L2, p["EE"] * p["BB"] * p["HH"] / L2, p["BB"] * p["HH"] * L2
+        MQ = np.zeros((4, 4))
+        MQ[0, 0] = MQ[1, 1] = 0.5 * facm
+        MQ[2:, 2:] = facm * np.array([[8.0, 1.0], [1.0, 2.0]]) / (1.0 if axial_mass == "published" else 15.0)
+        KQ = np.zeros((4, 4))
+        KQ[0, 0] = fack * PI**4 / 24.0 * (p["HH"] / L2) ** 2
+        KQ[1, 1] = fack * PI**4 * 2.0 / 3.0 * (p["HH"] / L2) ** 2
+        KQ[2:, 2:] = fack * np.array([[16.0, -8.0], [-8.0, 7.0]]) / 3.0
+        BQ = np.zeros((4, 4))
+        BQ[0, 2], BQ[0, 3], BQ[1, 3] = -facb * 16.0 / PI**3, facb * (8.0 / PI**3 - 1.0 / PI), facb * 0.5 / PI
+        BQ[2, 0], BQ[3, 0], BQ[3, 1] = -BQ[0, 2], -BQ[0, 3], -BQ[1, 3]
+        self.c1 = np.array([0.0, 0.0, facb * 2.0 / 3.0, facb / 6.0])
+        self.c2 = np.array([facb * 2.0 / PI, 0.0, 0.0, 0.0])
+        self.c12 = np.array([0.0, 0.0, L2 * facb / 3.0, L2 * facb / 6.0])
+        self.c21 = np.array([L2 * facb / PI, -L2 * facb * 0.5 / PI, 0.0, 0.0])
+        DQ = np.zeros((4, 4))
+        if self.damping:  # as coded (DQ(3,4) carries one digit fewer than DQ(4,3))
+            DQ[0, 0], DQ[1, 1] = 5.0, 25.0
+            DQ[2, 2], DQ[2, 3] = 0.5 * 2.308375455264791e2, -0.5 * 2.62688487992052e2
+            DQ[3, 2], DQ[3, 3] = -0.5 * 2.626884879920526e2, 0.5 * 4.217421837156818e2
+        self.MQ, self.KQ, self.BQ, self.DQ = MQ, KQ, BQ, DQ
+
+    def M(self, t: float, q: Array) -> Array:
+        p = self.p
+        L1, L2, M2, RHO = p["L1"], p["L2"], p["M2"], p["RHO"]
+        Q = q[3:]
+        c12p, s12p = np.cos(q[0] - q[1]), np.sin(q[0] - q[1])
+        A = np.zeros((7, 7))
+        A[0, 0] = p["J1"] + M2 * L1 * L1
+        A[0, 1] = 0.5 * L1 * L2 * M2 * c12p + RHO * L1 * (s12p * self.c2 @ Q + c12p * self.c1 @ Q)
+        A[1, 1] = p["J2"] + Q @ self.MQ @ Q + 2.0 * RHO * self.c12 @ Q
+        A[2, 2] = p["M3"]
+        A[0, 3:] = RHO * L1 * (-s12p * self.c1 + c12p * self.c2)
+        A[1, 3:] = RHO * self.c21 + RHO * (Q @ self.BQ)
+        A[3:, 3:] = self.MQ
+        return np.triu(A) + np.triu(A, 1).T
+
+    def Q(self, t: float, q: Array, v: Array) -> Array:
+        p = self.p
+        L1, L2, M2, RHO, G = p["L1"], p["L2"], p["M2"], p["RHO"], p["GRAV"]
+        Q, QD = q[3:], v[3:]
+        c1p, c2p, s12p, c12p = np.cos(q[0]), np.cos(q[1]), np.sin(q[0] - q[1]), np.cos(q[0] - q[1])
+        s2p = np.sin(q[1])
+        c1, c2, c12 = self.c1, self.c2, self.c12
+        MQQ, BQQD = self.MQ @ Q, self.BQ @ QD
+        F = np.zeros(7)
+        F[0] = -0.5 * L1 * G * (p["M1"] + 2.0 * M2) * c1p - 0.5 * L1 * L2 * M2 * v[1] ** 2 * s12p
+        F[1] = -0.5 * L2 * G * M2 * c2p + 0.5 * L1 * L2 * M2 * v[0] ** 2 * s12p
+        F[0] += (RHO * L1 * v[1] ** 2 * (-s12p * c1 @ Q + c12p * c2 @ Q)
+                 - 2.0 * RHO * L1 * v[1] * (c12p * c1 @ QD + s12p * c2 @ QD))
+        F[1] += (RHO * L1 * v[0] ** 2 * (s12p * c1 @ Q - c12p * c2 @ Q) - 2.0 * RHO * v[1] * c12 @ QD
+                 - 2.0 * v[1] * QD @ MQQ - RHO * QD @ BQQD - RHO * G * (c2p * c1 @ Q - s2p * c2 @ Q))
+        F[3:] = (v[1] ** 2 * MQQ + RHO * (v[1] ** 2 * c12 + L1 * v[0] ** 2 * (c12p * c1 + s12p * c2)
+                                          + 2.0 * v[1] * BQQD)
+                 - RHO * G * (s2p * c1 + c2p * c2) - self.KQ @ Q - self.DQ.T @ QD)
+        if self.nonlinear:
+            fk = 0.5 * p["EE"] * p["BB"] * p["HH"] / L2**2 * p["PI"] ** 2
+            fb = 80.0 / (p["PI"] ** 2 * 9.0)
+            F[3] -= fk * (Q[0] * Q[3] - fb * Q[1] * (-4 * Q[2] + 2 * Q[3]))
+            F[4] -= fk * (4 * Q[1] * Q[3] - fb * Q[0] * (-4 * Q[2] + 2 * Q[3]))
+            F[5] -= fk * 4.0 * fb * Q[0] * Q[1]
+            F[6] -= fk * (0.5 * Q[0] ** 2 + 2 * Q[1] ** 2 - 2 * fb * Q[0] * Q[1])
+        return F
+
+    def Phi(self, t: float, q: Array) -> Array:
+        p = self.p
+        L1, L2 = p["L1"], p["L2"]
+        return np.array([L1 * np.sin(q[0]) + (L2 + q[6]) * np.sin(q[1]),
+                         q[2] - L1 * np.cos(q[0]) - (L2 + q[6]) * np.cos(q[1]),
+                         q[0] - p["OMEGA"] * t])
+
+    def Phi_q(self, t: float, q: Array) -> Array:
+        L1, L2 = self.p["L1"], self.p["L2"]
+        G = np.zeros((3, 7))
+        G[0, 0], G[0, 1], G[0, 6] = L1 * np.cos(q[0]), (L2 + q[6]) * np.cos(q[1]), np.sin(q[1])
+        G[1, 0], G[1, 1], G[1, 2], G[1, 6] = L1 * np.sin(q[0]), (L2 + q[6]) * np.sin(q[1]), 1.0, -np.cos(q[1])
+        G[2, 0] = 1.0
+        return G
+
+    def nu(self, t: float, q: Array) -> Array:
+        return np.array([0.0, 0.0, self.p["OMEGA"]])
+
+    def gamma(self, t: float, q: Array, v: Array) -> Array:
+        L1, L2 = self.p["L1"], self.p["L2"]
+        s1, c1, s2, c2 = np.sin(q[0]), np.cos(q[0]), np.sin(q[1]), np.cos(q[1])
+        return np.array([
+            L1 * s1 * v[0] ** 2 + (L2 + q[6]) * s2 * v[1] ** 2 - 2.0 * v[1] * c2 * v[6],
+            -L1 * c1 * v[0] ** 2 - (L2 + q[6]) * c2 * v[1] ** 2 - 2.0 * v[1] * s2 * v[6],
+            0.0,
+        ])
+
+    def reaction_groups(self) -> dict[str, NDArray[np.int64]]:
+        return {"wrist pin": np.array([0, 1]), "crank drive": np.array([2])}

@@ -23,6 +23,19 @@ share of the beam) joined by revolute joints with rotational springs ``EI/ℓ`` 
 :math:`ℓ^3/EI\,[N^2/2 + (N-1)N(2N-1)/6]` equals :math:`L^3/3EI` up to :math:`O(N^{-2})`).  It is
 inextensible; its centrifugal stiffening comes from the exact kinematics, not from a
 geometric-stiffness matrix.
+
+Slider crank with an elastic connecting rod (Simeon 1996)
+---------------------------------------------------------
+Simeon's benchmark (B. Simeon, Math. Modelling of Systems 2 (1996) 1–18; the Test Set for IVP
+Solvers, problem "crank"): crank 0.15 m driven at Ω = 150 rad/s, steel connecting rod 0.30 m with
+an 8 mm × 8 mm section (E = 2e11 Pa, ρ = 7870 kg/m³), slider of mass m₂/2 on the x axis, no
+gravity; started (the test set's second initial-value set) with the rod straight and the rigid
+mechanism's velocities.  :func:`slider_crank_flexible` makes the rod a flexible body reduced by
+Craig–Bampton with the end translations as interface (rigid content removed, so the frame is the
+mean axes) and joins it at two node frames; :func:`slider_crank_chain` is the independent,
+geometrically exact reference: the rod as a pinned–pinned Hencky chain of rigid links.  The
+output is the midpoint's deflection from the chord between the rod's ends,
+:func:`chord_deflection`.
 """
 
 from __future__ import annotations
@@ -32,7 +45,8 @@ import numpy as np
 from ..drivers import TimeFunction
 from ..model import Model, ModelBuilder
 
-__all__ = ["KANE_SPIN_UP", "spin_up_angle", "spin_up_beam", "spin_up_chain", "hub_frame_deflection"]
+__all__ = ["KANE_SPIN_UP", "SIMEON_ROD", "chord_deflection", "hub_frame_deflection", "slider_crank_chain",
+           "slider_crank_flexible", "spin_up_angle", "spin_up_beam", "spin_up_chain"]
 
 #: data of the spin-up beam (Kane, Ryan & Banerjee 1987, sec. V)
 KANE_SPIN_UP = dict(length=10.0, rho=3000.0, area=4e-4, E=7e10, I=2e-7, T_s=15.0, omega_s=6.0)
@@ -115,3 +129,91 @@ def hub_frame_deflection(tip: np.ndarray, theta: np.ndarray, length: float) -> t
     for tip positions ``(n, 2)`` (the hub on the axis) and hub angles ``(n,)``."""
     c, s = np.cos(theta), np.sin(theta)
     return -s * tip[:, 0] + c * tip[:, 1], c * tip[:, 0] + s * tip[:, 1] - length
+
+
+#: Simeon's slider crank (Simeon 1996; Test Set for IVP Solvers "crank")
+SIMEON_ROD = dict(l1=0.15, l2=0.30, m1=0.36, J1=0.002727, E=2.0e11, nu=0.3, rho=7870.0, width=0.008,
+                  height=0.008, omega=150.0)
+
+
+def _rigid_start(p):
+    """Rigid slider crank at crank angle 0: crank pin A, wrist pin B, rod rate (Simeon's set 2)."""
+    l1, l2, w1 = p["l1"], p["l2"], p["omega"]
+    return np.array([l1, 0.0]), np.array([l1 + l2, 0.0]), np.array([0.0, l1 * w1]), -l1 * w1 / l2
+
+
+def _crank_and_slider(b, p, slider_mass, A, B, vA):
+    b.add_body("crank", p["m1"], p["J1"] - p["m1"] * (p["l1"] / 2) ** 2, A / 2, velocity=vA / 2,
+               angular_velocity=p["omega"])
+    b.add_body("slider", slider_mass, 0.0, B)
+    b.add_revolute("crank pivot", "ground", "crank", (0.0, 0.0))
+    b.add_translational("slider guide", "ground", "slider", B, (1.0, 0.0))
+    from ..drivers import ramp
+
+    b.add_angle_driver("crank drive", "crank pivot", ramp(p["omega"]))
+
+
+def slider_crank_flexible(n_elements: int = 8, n_modes: int = 4, theory: str = "euler-bernoulli",
+                          geometric_stiffening: bool = False, damping_ratio=0.0) -> Model:
+    """Simeon's slider crank with the rod a flexible body (module docstring): ``n_elements`` beam
+    elements, Craig–Bampton with the two end nodes' translations as interface and ``n_modes``
+    fixed-interface modes, rigid-body content removed (``1 + n_modes`` modal coordinates).  Node
+    frames ``rod.A`` (crank pin), ``rod.mid`` and ``rod.B`` (wrist pin)."""
+    from . import BeamSection, FEModel, craig_bampton, straight_beam
+
+    if n_elements % 2:
+        raise ValueError("slider_crank_flexible: n_elements must be even (a node at mid-length)")
+    p = SIMEON_ROD
+    section = BeamSection.rectangle(E=p["E"], rho=p["rho"], width=p["height"], height=p["width"], nu=p["nu"])
+    fe = FEModel.from_beam(straight_beam(p["l2"], n_elements, dim=2), section, theory)
+    interface = np.concatenate([fe.dofs(0, [0, 1]), fe.dofs(n_elements, [0, 1])])
+    modes = craig_bampton(fe.M, fe.K, interface, n_modes).orthonormalized(drop_rigid=True)
+    A, B, vA, w2 = _rigid_start(p)
+    b = ModelBuilder(2, "flexible slider crank", gravity=(0.0, 0.0))
+    m_rod = p["rho"] * section.A * p["l2"]
+    _crank_and_slider(b, p, m_rod / 2, A, B, vA)
+    b.add_flexible_body("rod", fe, modes, position=A, velocity=vA, angular_velocity=w2,
+                        geometric_stiffening=geometric_stiffening, damping_ratio=damping_ratio)
+    b.add_node_frame("rod", 0, "rod.A")
+    b.add_node_frame("rod", n_elements // 2, "rod.mid")
+    b.add_node_frame("rod", n_elements, "rod.B")
+    b.add_revolute("crank pin", "crank", "rod.A", A)
+    b.add_revolute("wrist pin", "rod.B", "slider", B)
+    return b.build()
+
+
+def slider_crank_chain(n_links: int = 16) -> Model:
+    """Simeon's slider crank with the rod a pinned–pinned Hencky chain: ``n_links`` (even) rigid links
+    with their share of the rod's mass and rotary inertia, rotational springs ``EI/ℓ`` at the
+    ``n_links − 1`` inner joints; the midpoint is the joint ``mid`` between links ``n/2`` and
+    ``n/2 + 1`` (the end of link ``rod{n/2}``)."""
+    if n_links % 2:
+        raise ValueError("slider_crank_chain: n_links must be even (a joint at mid-length)")
+    p = SIMEON_ROD
+    A, B, vA, w2 = _rigid_start(p)
+    area = p["width"] * p["height"]
+    EI = p["E"] * p["width"] * p["height"] ** 3 / 12.0
+    ell = p["l2"] / n_links
+    m = p["rho"] * area * ell
+    b = ModelBuilder(2, f"slider crank, rod of {n_links} rigid links", gravity=(0.0, 0.0))
+    _crank_and_slider(b, p, p["rho"] * area * p["l2"] / 2, A, B, vA)
+    prev = "crank"
+    for i in range(n_links):
+        name = f"rod{i + 1}"
+        x = A[0] + (i + 0.5) * ell
+        b.add_body(name, m, m * ell**2 / 12.0, (x, 0.0), velocity=(0.0, vA[1] + w2 * (x - A[0])),
+                   angular_velocity=w2)
+        b.add_revolute("crank pin" if i == 0 else f"rod joint {i}", prev, name, (A[0] + i * ell, 0.0))
+        if i > 0:
+            b.add_rotational_spring_damper(f"rod spring {i}", prev, name, EI / ell)
+        prev = name
+    b.add_revolute("wrist pin", prev, "slider", B)
+    return b.build()
+
+
+def chord_deflection(a: np.ndarray, mid: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Deflection [m] of ``mid`` from the chord ``a``–``b`` (positive along the chord turned by +90°),
+    for positions of shape (n, 2): ``(mid − (a + b)/2) · R e``, ``e = (b − a)/|b − a|``."""
+    e = (b - a) / np.linalg.norm(b - a, axis=1, keepdims=True)
+    n = np.stack([-e[:, 1], e[:, 0]], 1)
+    return np.einsum("ni,ni->n", mid - 0.5 * (a + b), n)

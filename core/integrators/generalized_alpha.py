@@ -139,10 +139,16 @@ class ConstraintCurvature:
     """
 
     def __init__(self, system, t, q):
-        J = _sparse(system.Phi_q(t, q))
+        J_raw = system.Phi_q(t, q)
+        J = _sparse(J_raw)
         self.system = system
-        S = J.copy()  # structural pattern (the Model keeps explicit zeros of its fixed pattern)
-        S.data = np.ones_like(S.data)
+        if sp.issparse(J_raw):
+            S = J.copy()  # structural pattern (the Model keeps explicit zeros of its fixed pattern)
+            S.data = np.ones_like(S.data)
+        else:
+            # a dense Jacobian has no structural zeros: an entry that is zero at this q (sin 0 in a
+            # loop closure) need not stay zero, so every entry is in the pattern
+            S = sp.csr_matrix(np.ones(np.shape(J_raw)))
         G = (S.T @ S).tocsr()  # columns sharing a row of J, and (through JᵀJ) distance-2 partners
         G2 = (G @ G).tocsr()
         n = J.shape[1]
@@ -158,7 +164,7 @@ class ConstraintCurvature:
         self.n_colors = int(color.max()) + 1 if n else 0
         P = G.tocoo()  # the derivative pattern of Φ_qᵀλ (structural, includes diagonal blocks)
         self.P_rows, self.P_cols = P.row, P.col
-        Jc = J.tocoo()
+        Jc = S.tocoo()
         self.J_rows, self.J_cols = Jc.row, Jc.col
         self.groups = [np.flatnonzero(color == c) for c in range(self.n_colors)]
         self.shape_P = (n, n)

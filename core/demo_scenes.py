@@ -29,6 +29,10 @@ SCENES = [
                   "Spin-up beam: flexible body with and without geometric stiffening",
                   "Kane, Ryan & Banerjee (1987); floating frame with cantilever modes against a geometrically exact "
                   "rigid-link chain.", full_adds="chains of 20 and 40 links as the reference."),
+    example_scene("flexible-slider-crank", "core/flexible_slider_crank.py",
+                  "Slider crank with an elastic rod: published model, flexible body and rigid-link rod",
+                  "Simeon (1996); Test Set for IVP Solvers 'crank'.",
+                  full_adds="16 elements and 5 modes; rigid-link rods of 16 and 32 links."),
     # the work-precision report is part of the main job (``make run``)
     example_scene("work-precision", "core/work_precision.py",
                   "Work-precision: error against run time for every integrator",

@@ -247,7 +247,7 @@ class ModelBuilder:
 
     def add_flexible_body(self, name: str, fe_model, modes, position=None, orientation=None, velocity=None,
                           angular_velocity=None, modal_coordinates=None, modal_velocities=None,
-                          damping_ratio=0.0, geometric_stiffening: bool = False) -> str:
+                          damping_ratio=0.0, geometric_stiffening: bool | str = False) -> str:
         """Add a flexible body: a floating frame of reference with the modes of a reduced FE component
         (:mod:`core.flexible.body`).
 
@@ -265,8 +265,9 @@ class ModelBuilder:
             Initial modal coordinates and rates (default 0).
         damping_ratio : float, str or array_like
             Modal damping ratio ζ (``0.02`` or ``"2 %"``), one for all modes or one per mode.
-        geometric_stiffening : bool
-            Add the centrifugal geometric stiffness (needed for fast-spinning slender bodies).
+        geometric_stiffening : bool or str
+            True or ``"centrifugal"``: the geometric stiffness of the centrifugal load, scaled with the
+            spin (fast-spinning slender bodies); False (default): linear elastic.
 
         Returns
         -------

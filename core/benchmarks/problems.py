@@ -301,6 +301,22 @@ def _max_abs_q_error(system, q, v, q_ref) -> float:
     return float(np.max(np.abs(np.asarray(q, float) - q_ref)))
 
 
+def _simeon_crank_system():
+    from .testset import SimeonCrank
+
+    return SimeonCrank()
+
+
+def _simeon_crank_reference() -> float:
+    from .testset import SimeonCrank
+
+    return float(SimeonCrank.reference["q"][3])
+
+
+def _simeon_crank_error(system, q, v, q1_ref) -> float:
+    return float(abs(q[3] - q1_ref))
+
+
 def _andrews_cartesian_system():
     from ..models import andrews_cartesian
 
@@ -497,6 +513,23 @@ def _build_registry() -> None:
                "full": Grid(rtols=_geom(1e-3, 1e-10, 1), steps=_geom(1e-2, 1e-4, 2))},
     ))
     register_problem(WorkPrecisionProblem(
+        name="simeon-crank",
+        title="Slider crank with an elastic rod (Simeon), published two-mode model, index-3 DAE (t = 0.1 s)",
+        build_system=_simeon_crank_system,
+        t_end=0.1,
+        reference_fn=_simeon_crank_reference,
+        error_fn=_simeon_crank_error,
+        error_measure="|q1 - q1_ref|, the rod's midpoint deflection [m]",
+        reference_note=("published solution at t = 0.1 s: Test Set for IVP Solvers, crank.f, subroutine cranksoln "
+                        "(MEBDFI, rtol = atol = 1e-14); core.benchmarks.testset.SimeonCrank.reference"),
+        conservative=False,
+        grids={"quick": Grid(rtols=(1e-5,), steps=(1e-5,), methods=("dop853-projection", "radau-ggl")),
+               # about 11 s per repeat on the 2-core host; the full grid covers every method
+               "standard": Grid(rtols=(1e-4, 1e-6), steps=(1e-5,),
+                                methods=("dop853-projection", "radau-ggl", "generalized-alpha")),
+               "full": Grid(rtols=_geom(1e-3, 1e-10, 1), steps=_geom(1e-4, 1e-6, 2))},
+    ))
+    register_problem(WorkPrecisionProblem(
         name="pendulum-100s",
         title="Simple pendulum (IFToMM A01: 1 kg point mass, 1 m massless link, from horizontal), t = 100 s",
         build_system=_pendulum_system,
@@ -526,7 +559,7 @@ PROBLEM_SETS: dict[str, list[str]] = {
     # follow the undamped 2.8e4 rad/s spring oscillation at 1e-12)
     "standard": ["chain2-planar", "chain8-planar", "chain2-spatial", "chain32-planar",
                  "chain2-stiff-k1e4", "chain2-stiff-k1e6", "chain8-stiff-k1e6", "andrews", "car-axis",
-                 "pendulum-100s", "iftomm-a04"],
+                 "pendulum-100s", "iftomm-a04", "simeon-crank"],
 }
 
 

@@ -361,6 +361,43 @@ def _geometric_bending(L):
                                         [3 * L, -L**2, -3 * L, 4 * L**2]])
 
 
+def _unit_geometric(mesh: BeamMesh, e: int):
+    """(element dof indices, global-axes geometric stiffness of element e per unit axial force)."""
+    L, R = _local_axes(mesh, e)
+    i, j = mesh.elements[e]
+    n = mesh.dofs_per_node
+    Gb = _geometric_bending(L)
+    if mesh.dim == 2:
+        Kl = np.zeros((6, 6))
+        bd = [1, 2, 4, 5]
+        Kl[np.ix_(bd, bd)] = Gb
+        T = np.zeros((6, 6))
+        for k in (0, 3):
+            T[k:k + 2, k:k + 2] = R
+            T[k + 2, k + 2] = 1.0
+    else:
+        Kl = np.zeros((12, 12))
+        Kl[np.ix_([1, 5, 7, 11], [1, 5, 7, 11])] = Gb
+        S = np.diag([1.0, -1.0, 1.0, -1.0])
+        Kl[np.ix_([2, 4, 8, 10], [2, 4, 8, 10])] = S @ Gb @ S
+        T = np.zeros((12, 12))
+        for k in range(4):
+            T[3 * k:3 * k + 3, 3 * k:3 * k + 3] = R
+    idx = np.concatenate([np.arange(n) + i * n, np.arange(n) + j * n])
+    return idx, T.T @ Kl @ T
+
+
+def _assemble(mesh: BeamMesh, parts) -> sp.csr_matrix:
+    rows, cols, vals = [], [], []
+    for idx, Ke in parts:
+        r, c = np.meshgrid(idx, idx, indexing="ij")
+        rows.append(r.ravel())
+        cols.append(c.ravel())
+        vals.append(Ke.ravel())
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(mesh.n_dofs, mesh.n_dofs))
+
+
 def geometric_stiffness(mesh: BeamMesh, section: BeamSection, u) -> sp.csr_matrix:
     r"""Geometric (stress) stiffness of the mesh in the axial-force state of the displacement ``u``.
 
@@ -376,38 +413,15 @@ def geometric_stiffness(mesh: BeamMesh, section: BeamSection, u) -> sp.csr_matri
         Nodal displacements [m, rad] in the mesh's global axes.
     """
     u = np.asarray(u, float).reshape(mesh.n_dofs)
-    n = mesh.dofs_per_node
-    rows, cols, vals = [], [], []
+    n, d = mesh.dofs_per_node, mesh.dim
+    parts = []
     for e in range(mesh.elements.shape[0]):
         L, R = _local_axes(mesh, e)
         i, j = mesh.elements[e]
-        d = mesh.dim
         N = section.E * section.A * float(R[0] @ (u[j * n:j * n + d] - u[i * n:i * n + d])) / L
-        Gb = N * _geometric_bending(L)
-        if d == 2:
-            Kl = np.zeros((6, 6))
-            bd = [1, 2, 4, 5]
-            Kl[np.ix_(bd, bd)] = Gb
-            T = np.zeros((6, 6))
-            for k in (0, 3):
-                T[k:k + 2, k:k + 2] = R
-                T[k + 2, k + 2] = 1.0
-        else:
-            Kl = np.zeros((12, 12))
-            Kl[np.ix_([1, 5, 7, 11], [1, 5, 7, 11])] = Gb
-            S = np.diag([1.0, -1.0, 1.0, -1.0])
-            Kl[np.ix_([2, 4, 8, 10], [2, 4, 8, 10])] = S @ Gb @ S
-            T = np.zeros((12, 12))
-            for k in range(4):
-                T[3 * k:3 * k + 3, 3 * k:3 * k + 3] = R
-        Ke = T.T @ Kl @ T
-        idx = np.concatenate([np.arange(n) + i * n, np.arange(n) + j * n])
-        r, c = np.meshgrid(idx, idx, indexing="ij")
-        rows.append(r.ravel())
-        cols.append(c.ravel())
-        vals.append(Ke.ravel())
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(mesh.n_dofs, mesh.n_dofs))
+        idx, G = _unit_geometric(mesh, e)
+        parts.append((idx, N * G))
+    return _assemble(mesh, parts)
 
 
 @dataclass(frozen=True)

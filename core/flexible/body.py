@@ -146,7 +146,7 @@ class FlexibleBodyData:
         Modal stiffness and damping.
     KG : (n_products, n_modes, n_modes) ndarray or None
         Geometric stiffness per unit :math:`\\omega_i\\omega_j` (planar: one product ω²; spatial:
-        ω_x², ω_xω_y, ω_xω_z, ω_y², ω_yω_z, ω_z²), or None without geometric stiffening.
+        ω_x², ω_xω_y, ω_xω_z, ω_y², ω_yω_z, ω_z²), or None without centrifugal stiffening.
     nodes : (N, dim) ndarray
         Node positions in the frame [m].
     dofs_per_node : int
@@ -250,7 +250,7 @@ class FlexibleBodyData:
     def potential(self, r: Array, A: Array, qf: Array, g: Array) -> float:
         """Gravitational plus strain energy [J]: ``−gᵀ(m r + A s(q_f)) + ½ q_fᵀ K q_f``."""
         s = self.first_moment + self.S @ qf
-        return float(-g @ (self.mass * r + A @ s) + 0.5 * qf @ (self.K @ qf))
+        return float(-g @ (self.mass * r + A @ s)) + self.strain_energy(qf)
 
     def strain_energy(self, qf: Array) -> float:
         """½ q_fᵀ K q_f [J]."""
@@ -311,8 +311,25 @@ def _rotation_field(nodes: Array, p: int, U: Array, Psi: Array | None, j: int) -
     return out
 
 
+#: the kinds of geometric stiffening (module docstring); True means "centrifugal"
+STIFFENING = ("centrifugal",)
+
+
+def _stiffening(name, value) -> bool:
+    """Whether ``geometric_stiffening`` asks for the centrifugal geometric stiffness."""
+    if value is None or value is False:
+        return False
+    if value is True or value == "centrifugal":
+        return True
+    from ..inputs import closest
+
+    hint = closest(value, STIFFENING) if isinstance(value, str) else None
+    raise ModelError(f"flexible body {name!r}: geometric_stiffening={value!r}; give False, True or 'centrifugal'"
+                     + (f" (did you mean {hint!r}?)" if hint else ""))
+
+
 def flexible_body_data(name: str, fe: FEModel, modes: ModalComponent, damping_ratio=0.0,
-                       geometric_stiffening: bool = False, dim: int | None = None) -> FlexibleBodyData:
+                       geometric_stiffening=False, dim: int | None = None) -> FlexibleBodyData:
     """Check a component and compute its run-time data (module docstring).
 
     Raises
@@ -390,10 +407,11 @@ def flexible_body_data(name: str, fe: FEModel, modes: ModalComponent, damping_ra
     Dm = Mr @ X @ np.diag(2.0 * zeta * omega) @ X.T @ Mr
     # --- geometric stiffening -------------------------------------------------------------------------
     KG = None
-    if geometric_stiffening:
-        if fe.geometric_stiffness is None:
-            raise ModelError(f"flexible body {name!r}: geometric stiffening needs the component's geometric stiffness; "
-                             f"{fe.source or 'this FE model'} has none (beam components have it; imported matrices do not)")
+    centrifugal = _stiffening(name, geometric_stiffening)
+    if centrifugal and fe.geometric_stiffness is None:
+        raise ModelError(f"flexible body {name!r}: geometric stiffening needs the component's geometric stiffness; "
+                         f"{fe.source or 'this FE model'} has none (beam components have it; imported matrices do not)")
+    if centrifugal:
         KG = np.array([_unit_geometric_stiffness(name, fe, Mfe, T, B, nodes, p, t_idx) for B in _products_B(d)])
     return FlexibleBodyData(name, d, r, m, gram, mass, first, S, Kr, 0.5 * (Dm + Dm.T), KG, nodes, p, T,
                             omega / (2.0 * np.pi), tuple(modes.labels), fe.source)

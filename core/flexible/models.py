@@ -76,7 +76,7 @@ def spin_up_angle(omega_s: float = 6.0, T_s: float = 15.0) -> TimeFunction:
                         f"spin-up to {omega_s:g} rad/s in {T_s:g} s")
 
 
-def spin_up_beam(n_elements: int = 20, n_modes: int = 4, geometric_stiffening: bool = True,
+def spin_up_beam(n_elements: int = 20, n_modes: int = 4, geometric_stiffening: bool | str = True,
                  omega_s: float = 6.0, T_s: float = 15.0, dimension: int = 2) -> Model:
     """The spin-up beam as one flexible body with cantilever modes (module docstring).
 
@@ -154,7 +154,7 @@ def _crank_and_slider(b, p, slider_mass, A, B, vA):
 
 
 def slider_crank_flexible(n_elements: int = 8, n_modes: int = 4, theory: str = "euler-bernoulli",
-                          geometric_stiffening: bool = False, damping_ratio=0.0) -> Model:
+                          geometric_stiffening: bool | str = False, damping_ratio=0.0, frame: str = "mean axes") -> Model:
     """Simeon's slider crank with the rod a flexible body (module docstring): ``n_elements`` beam
     elements, Craig–Bampton with the two end nodes' translations as interface and ``n_modes``
     fixed-interface modes, rigid-body content removed (``1 + n_modes`` modal coordinates).  Node
@@ -166,8 +166,14 @@ def slider_crank_flexible(n_elements: int = 8, n_modes: int = 4, theory: str = "
     p = SIMEON_ROD
     section = BeamSection.rectangle(E=p["E"], rho=p["rho"], width=p["height"], height=p["width"], nu=p["nu"])
     fe = FEModel.from_beam(straight_beam(p["l2"], n_elements, dim=2), section, theory)
-    interface = np.concatenate([fe.dofs(0, [0, 1]), fe.dofs(n_elements, [0, 1])])
-    modes = craig_bampton(fe.M, fe.K, interface, n_modes).orthonormalized(drop_rigid=True)
+    if frame == "mean axes":
+        interface = np.concatenate([fe.dofs(0, [0, 1]), fe.dofs(n_elements, [0, 1])])
+        modes = craig_bampton(fe.M, fe.K, interface, n_modes).orthonormalized(drop_rigid=True)
+    elif frame == "chord":  # Simeon's frame: origin at the crank pin, x axis through the wrist pin
+        held = np.concatenate([fe.dofs(0, [0, 1]), fe.dofs(n_elements, [1])])
+        modes = craig_bampton(fe.M, fe.K, fe.dofs(n_elements, [0]), n_modes, fixed_dofs=held).orthonormalized()
+    else:
+        raise ValueError(f"slider_crank_flexible: frame must be 'mean axes' or 'chord', got {frame!r}")
     A, B, vA, w2 = _rigid_start(p)
     b = ModelBuilder(2, "flexible slider crank", gravity=(0.0, 0.0))
     m_rod = p["rho"] * section.A * p["l2"]

@@ -343,6 +343,8 @@ def test_bad_flexible_inputs_are_refused_by_name():
     imported = FEModel(fe.nodes, 3, fe.M, fe.K, "imported")
     with pytest.raises(ModelError, match="geometric stiffening.*imported"):
         ModelBuilder(2).add_flexible_body("arm", imported, modes, geometric_stiffening=True)
+    with pytest.raises(ModelError, match="geometric_stiffening='centrifgual'.*did you mean 'centrifugal'"):
+        ModelBuilder(2).add_flexible_body("arm", fe, modes, geometric_stiffening="centrifgual")
     with pytest.raises(ModelError, match="2 finite numbers"):
         ModelBuilder(2).add_flexible_body("arm", fe, modes, modal_coordinates=[0.0])
 

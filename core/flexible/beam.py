@@ -70,7 +70,7 @@ from ..errors import InputError
 from ..inputs import parse_quantity
 
 __all__ = ["BeamGeometricStiffness", "BeamMesh", "BeamSection", "beam_matrices", "geometric_stiffness",
-           "straight_beam", "THEORIES"]
+           "section_forces", "straight_beam", "SECTION_FORCES", "THEORIES"]
 
 THEORIES = ("euler-bernoulli", "timoshenko")
 
@@ -282,6 +282,55 @@ def _local_axes(mesh: BeamMesh, e: int) -> tuple[float, np.ndarray]:
                          "orientation vector that is not parallel to the element")
     ey /= np.linalg.norm(ey)
     return L, np.array([ex, ey, np.cross(ex, ey)])
+
+
+def _element_rotation(mesh: BeamMesh, e: int) -> np.ndarray:
+    """The rotation of element e's nodal dofs into its local axes, (6, 6) or (12, 12)."""
+    _, R = _local_axes(mesh, e)
+    if mesh.dim == 2:
+        T = np.zeros((6, 6))
+        for n in (0, 3):
+            T[n:n + 2, n:n + 2] = R
+            T[n + 2, n + 2] = 1.0
+        return T
+    T = np.zeros((12, 12))
+    for n in range(4):
+        T[3 * n:3 * n + 3, 3 * n:3 * n + 3] = R
+    return T
+
+
+#: the section forces of :func:`section_forces`, planar and spatial
+SECTION_FORCES = {2: ("N [N]", "V [N]", "M [N m]"),
+                  3: ("N [N]", "Vy [N]", "Vz [N]", "T [N m]", "My [N m]", "Mz [N m]")}
+
+
+def section_forces(mesh: BeamMesh, section: BeamSection, u, theory: str = "euler-bernoulli") -> np.ndarray:
+    r"""Section forces at both ends of every element for the nodal displacements ``u``.
+
+    The element's end loads in its local axes, :math:`f = T K_e u_e` (the loads the nodes apply to
+    the element), give the section forces at the two ends as the load that the part of the beam
+    towards node j transmits to the part towards node i: :math:`-f_i` at end i, :math:`+f_j` at end
+    j.  So tension and a moment that turns the far part positively about the local axis are
+    positive; a cantilever along x with a tip load P along y has :math:`M_z = P(L - x)`.  They are
+    exact for the element's own shape functions: static loads at nodes give the exact section forces
+    of an Euler–Bernoulli beam; distributed inertia loads converge with the mesh.
+
+    Returns
+    -------
+    (n_el, 2, 3) or (n_el, 2, 6) ndarray
+        Per element and end (i, j): ``SECTION_FORCES[dim]`` (N, V, M in the plane; N, V_y, V_z, T,
+        M_y, M_z in space) [N, N m].
+    """
+    u = np.asarray(u, float).reshape(mesh.n_dofs)
+    n = mesh.dofs_per_node
+    out = np.empty((mesh.elements.shape[0], 2, n))
+    for e in range(mesh.elements.shape[0]):
+        Ke, _ = element_matrices(mesh, section, e, theory)
+        i, j = mesh.elements[e]
+        ue = np.concatenate([u[i * n:(i + 1) * n], u[j * n:(j + 1) * n]])
+        f = _element_rotation(mesh, e) @ (Ke @ ue)
+        out[e, 0], out[e, 1] = -f[:n], f[n:]
+    return out
 
 
 def element_matrices(mesh: BeamMesh, section: BeamSection, e: int, theory: str = "euler-bernoulli"):

@@ -157,6 +157,8 @@ class FlexibleBodyData:
     labels : tuple of str
         What each modal coordinate is.
     source : str
+    beam : tuple or None
+        ``(mesh, section, theory)`` of a beam component (section forces), else None.
     """
 
     name: str
@@ -176,6 +178,7 @@ class FlexibleBodyData:
     frequencies: Array
     labels: tuple
     source: str
+    beam: tuple | None = None
 
     # --- node kinematics ------------------------------------------------------------------
     def translation_rows(self, node: int) -> Array:
@@ -193,6 +196,18 @@ class FlexibleBodyData:
     def node_displacements(self, qf: Array) -> Array:
         """Elastic displacements (and rotations) of every node in the frame, (N, dofs_per_node)."""
         return (self.T @ np.asarray(qf, float)).reshape(-1, self.dofs_per_node)
+
+    def section_forces(self, qf: Array) -> Array:
+        """Section forces at both ends of every beam element for the modal coordinates ``qf``
+        (:func:`core.flexible.beam.section_forces`: (n_el, 2, 3) in the plane, (n_el, 2, 6) in
+        space, N, V, M [N, N m]); :class:`ModelError` for a component that is not made of beams."""
+        if self.beam is None:
+            raise ModelError(f"flexible body {self.name!r}: section forces need a beam component; "
+                             f"{self.source or 'this component'} is not one (use node_displacements)")
+        from .beam import section_forces
+
+        mesh, section, theory = self.beam
+        return section_forces(mesh, section, self.T @ np.asarray(qf, float), theory)
 
     # --- dynamics ---------------------------------------------------------------------------
     def _D(self, qf: Array) -> Array:
@@ -414,7 +429,7 @@ def flexible_body_data(name: str, fe: FEModel, modes: ModalComponent, damping_ra
     if centrifugal:
         KG = np.array([_unit_geometric_stiffness(name, fe, Mfe, T, B, nodes, p, t_idx) for B in _products_B(d)])
     return FlexibleBodyData(name, d, r, m, gram, mass, first, S, Kr, 0.5 * (Dm + Dm.T), KG, nodes, p, T,
-                            omega / (2.0 * np.pi), tuple(modes.labels), fe.source)
+                            omega / (2.0 * np.pi), tuple(modes.labels), fe.source, fe.beam)
 
 
 def _damping(name, value, m):

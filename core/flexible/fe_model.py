@@ -33,7 +33,8 @@ class FEModel:
     ``geometric_stiffness``, where the element type provides one, is a callable ``u -> K_G(u)``:
     the stress stiffness in the stress state of the displacement ``u`` (beams:
     :class:`~core.flexible.beam.BeamGeometricStiffness`); flexible bodies use it for geometric
-    stiffening.  Imported matrices have none."""
+    stiffening.  Imported matrices have none.  ``beam`` is ``(mesh, section, theory)`` for a beam
+    component (section forces are recovered from it), else None."""
 
     nodes: np.ndarray
     dofs_per_node: int
@@ -41,6 +42,7 @@ class FEModel:
     K: sp.csr_matrix
     source: str = ""
     geometric_stiffness: object = None
+    beam: tuple | None = None
 
     def __post_init__(self):
         n = self.nodes.shape[0] * self.dofs_per_node
@@ -67,7 +69,7 @@ class FEModel:
 
         M, K = beam_matrices(mesh, section, theory)
         return cls(mesh.nodes, mesh.dofs_per_node, M, K, f"{theory} beam, {mesh.elements.shape[0]} elements",
-                   BeamGeometricStiffness(mesh, section))
+                   BeamGeometricStiffness(mesh, section), (mesh, section, theory))
 
     @classmethod
     def read(cls, mass, stiffness, nodes, dofs_per_node: int, length_unit: str = "m",

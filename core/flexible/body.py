@@ -457,8 +457,8 @@ def _unit_geometric_stiffness(name, fe, Mfe, T, B, nodes, p, t_idx):
     K = sp.csr_matrix(fe.K)
     if held.size:
         free = np.setdiff1d(np.arange(n), held)
-        try:
-            uf = spla.spsolve(K[free][:, free].tocsc(), f[free])
+        try:  # splu raises on an exactly singular matrix (spsolve would warn and return NaN)
+            uf = spla.splu(K[free][:, free].tocsc()).solve(f[free])
         except RuntimeError:
             uf = np.full(free.size, np.nan)
         u = np.zeros(n)
@@ -470,7 +470,7 @@ def _unit_geometric_stiffness(name, fe, Mfe, T, B, nodes, p, t_idx):
         Rm = rigid_body_modes(nodes, p, Mfe)
         MR = Mfe @ Rm
         fb = f - MR @ (Rm.T @ f)
-        u = spla.spsolve((K + sp.csr_matrix(MR @ MR.T)).tocsc(), fb)
+        u = spla.splu((K + sp.csr_matrix(MR @ MR.T)).tocsc()).solve(fb)
         u = u - Rm @ (MR.T @ u)
     KG = fe.geometric_stiffness(u)
     out = T.T @ (sp.csr_matrix(KG) @ T)

@@ -317,6 +317,37 @@ def _simeon_crank_error(system, q, v, q1_ref) -> float:
     return float(abs(q[3] - q1_ref))
 
 
+def _spin_up_system():
+    from ..flexible.models import spin_up_beam
+
+    return spin_up_beam(n_elements=20, n_modes=2, geometric_stiffening=True)
+
+
+def _spin_up_tip(system, q) -> float:
+    from ..flexible.models import hub_frame_deflection, spin_up_angle
+
+    tip = system.point_position(q, "beam.tip", np.zeros(2))
+    return float(hub_frame_deflection(tip[None], np.array([spin_up_angle()(SPIN_UP_T_END)[0]]), 10.0)[0][0])
+
+
+#: end time of the spin-up work-precision problem [s] (the lag is near its peak)
+SPIN_UP_T_END = 8.0
+
+
+def _spin_up_reference() -> float:
+    from ..simulation import simulate
+
+    system = _spin_up_system()
+    res = simulate(system, (0.0, SPIN_UP_T_END), "dop853-projection", rtol=1e-12, atol=1e-12, n_output=2)
+    if res.status != "finished":  # pragma: no cover - the reference run must succeed
+        raise RuntimeError(f"spin-up reference run: {res.message}")
+    return _spin_up_tip(system, res.q[-1])
+
+
+def _spin_up_error(system, q, v, v_ref) -> float:
+    return abs(_spin_up_tip(system, q) - v_ref)
+
+
 def _andrews_cartesian_system():
     from ..models import andrews_cartesian
 
@@ -528,6 +559,25 @@ def _build_registry() -> None:
                "standard": Grid(rtols=(1e-4, 1e-6), steps=(1e-5,),
                                 methods=("dop853-projection", "radau-ggl", "generalized-alpha")),
                "full": Grid(rtols=_geom(1e-3, 1e-10, 1), steps=_geom(1e-4, 1e-6, 2))},
+    ))
+    register_problem(WorkPrecisionProblem(
+        name="flexible-spin-up",
+        title="Spin-up beam (Kane, Ryan & Banerjee 1987): flexible body, 20 elements, 2 cantilever modes, "
+              "centrifugal stiffening, driven hub (t = 8 s)",
+        build_system=_spin_up_system,
+        t_end=SPIN_UP_T_END,
+        reference_fn=_spin_up_reference,
+        error_fn=_spin_up_error,
+        error_measure="|v_tip - v_tip,ref|, tip deflection in the hub frame [m]",
+        reference_note=("the same model by scipy DOP853 with coordinate projection at rtol = atol = 1e-12; the "
+                        "model itself is validated against a geometrically exact rigid-link chain (scene "
+                        "flexible-spin-up-beam)"),
+        conservative=False,
+        grids={"quick": Grid(rtols=(1e-5,), steps=(1e-2,), methods=("dop853-projection", "radau-projection")),
+               "standard": Grid(rtols=(1e-4, 1e-6, 1e-8), steps=(1e-2, 1e-3),
+                                methods=("rk45-projection", "dop853-projection", "radau-projection", "radau-ggl",
+                                         "bdf-projection", "generalized-alpha", "hht", "hem4")),
+               "full": Grid(rtols=_geom(1e-3, 1e-10, 1), steps=_geom(1e-2, 1e-4, 2))},
     ))
     register_problem(WorkPrecisionProblem(
         name="pendulum-100s",

@@ -772,7 +772,7 @@ class Model(ConstrainedSystem):
         self._M_flex_pos = [np.asarray(pos[np.repeat(f.vi, len(f.vi)), np.tile(f.vi, len(f.vi))]).ravel().astype(np.int64) - 1
                             for f in recs]
 
-    def _flexible_terms(self, q: Array, v: Array | None, want_M: bool = True):
+    def _flexible_terms(self, q: Array, v: Array | None):
         """Per flexible body ``(M_b, Q_b)`` at ``(q, v)`` (v None: zero velocities)."""
         out = []
         d = self.space.dim

@@ -470,7 +470,12 @@ def _unit_geometric_stiffness(name, fe, Mfe, T, B, nodes, p, t_idx):
         Rm = rigid_body_modes(nodes, p, Mfe)
         MR = Mfe @ Rm
         fb = f - MR @ (Rm.T @ f)
-        u = spla.splu((K + sp.csr_matrix(MR @ MR.T)).tocsc()).solve(fb)
+        try:
+            u = spla.splu((K + sp.csr_matrix(MR @ MR.T)).tocsc()).solve(fb)
+        except RuntimeError:
+            raise ModelError(f"flexible body {name!r}: the free component's stiffness with inertia relief is singular "
+                             "(a mechanism or disconnected parts); the centrifugal stress for geometric stiffening "
+                             "is undefined") from None
         u = u - Rm @ (MR.T @ u)
     KG = fe.geometric_stiffness(u)
     out = T.T @ (sp.csr_matrix(KG) @ T)
@@ -576,8 +581,8 @@ class FlexibleNodes(UserConstraint):
             C = np.einsum("ji,njk->nik", A, AN)
             tr = np.trace(C, axis1=1, axis2=2)[:, None, None] * np.eye(3)
             J[:, 3:, 3:6] = -0.5 * (tr - C)
-            for n in range(k):
-                J[n, 3:, nvb * (n + 1) + 3:nvb * (n + 2)] = 0.5 * (tr[n] - C[n].T)
+            cols = nvb * (idx + 1)[:, None, None] + 3 + np.arange(3)[None, None, :]  # each node's ω̄ columns
+            J[idx[:, None, None], 3 + np.arange(3)[None, :, None], cols] = 0.5 * (tr - np.swapaxes(C, 1, 2))
         return J.reshape(self.rows, -1)
 
     def gamma(self, t, q, v):

@@ -247,7 +247,7 @@ class ModelBuilder:
 
     def add_flexible_body(self, name: str, fe_model, modes, position=None, orientation=None, velocity=None,
                           angular_velocity=None, modal_coordinates=None, modal_velocities=None,
-                          damping_ratio=0.0, geometric_stiffening: bool | str = False) -> str:
+                          damping_ratio=0.0, geometric_stiffening: bool | str = False, inertia: str = "full") -> str:
         """Add a flexible body: a floating frame of reference with the modes of a reduced FE component
         (:mod:`core.flexible.body`).
 
@@ -268,6 +268,11 @@ class ModelBuilder:
         geometric_stiffening : bool or str
             True or ``"centrifugal"``: the geometric stiffness of the centrifugal load, scaled with the
             spin (fast-spinning slender bodies); False (default): linear elastic.
+        inertia : str
+            ``"full"`` (default): the kinetic energy of the deformed body, exact for the floating
+            frame; ``"undeformed"``: that of the undeformed body, a rigid body plus modal oscillators
+            coupled through the node frames (slowly rotating bodies such as a railway car body; the
+            form the compiled integrators take, :mod:`core.flexible.compiled`).
 
         Returns
         -------
@@ -278,7 +283,7 @@ class ModelBuilder:
         from .flexible.body import flexible_body_data
 
         self._check_new(name, "body")
-        data = flexible_body_data(name, fe_model, modes, damping_ratio, geometric_stiffening, self.space.dim)
+        data = flexible_body_data(name, fe_model, modes, damping_ratio, geometric_stiffening, self.space.dim, inertia)
         m = data.n_modes
         q0 = np.zeros(m) if modal_coordinates is None else np.asarray(modal_coordinates, float)
         qd0 = np.zeros(m) if modal_velocities is None else np.asarray(modal_velocities, float)

@@ -4,7 +4,9 @@
 * ``railway-critical-speed`` -- ``examples/railway/critical_speed.py`` on
   :mod:`railway.vehicles.critical_speed`;
 * ``railway-curving`` -- ``examples/railway/vehicle_curving.py`` on :mod:`railway.vehicles.curving`;
-* ``railway-irregular-track`` -- ``examples/railway/irregular_track.py`` on :mod:`railway.vehicles.ride`.
+* ``railway-irregular-track`` -- ``examples/railway/irregular_track.py`` on :mod:`railway.vehicles.ride`;
+* ``railway-ride-comfort`` -- ``examples/railway/ride_comfort.py`` on :mod:`railway.vehicles.ride_comfort`
+  (rigid and flexible car body, EN 12299 and Sperling).
 
 The functions this module held before (issue 22) moved to those modules; their old names here
 still resolve, with a :class:`DeprecationWarning` naming the new place.
@@ -70,4 +72,11 @@ def vehicle_scenes():
                       "Manchester coach on irregular straight track: car-body accelerations and wheel forces",
                       "ORE B176 low-level irregularities, speed sweep through core.sweep: car-body acceleration "
                       "r.m.s. and spectra, wheel forces."),
+        example_scene("railway-ride-comfort", "railway/ride_comfort.py",
+                      "Ride comfort: Manchester coach with rigid and flexible car body, EN 12299 and Sperling",
+                      "The same irregular track with the rigid car body and a flexible one (free-free equivalent "
+                      "beam, assumed 9 Hz bending, 12 Hz torsion): floor accelerations at the centre and over the "
+                      "bogies, EN 12299 mean comfort N_MV and Sperling's W_z per floor point, spectra.",
+                      full_adds="the bisection (to 0.25 m/s) of the speed where the flexible car body's N_MV at the "
+                                "centre first exceeds the rigid one's by 10 %."),
     ]

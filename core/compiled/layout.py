@@ -158,6 +158,13 @@ class Layout:
         self.n_q_body, self.n_v_body = sp_.n_q, sp_.n_v
         self.n_q, self.n_v = model.n_q, model.n_v
         self.extra_names = list(model.extra_names)
+        self.body_names = list(model.body_names)
+
+    def model_body_index(self, name: str) -> int:
+        """Index of a body of the model (the ground: ``n_bodies``)."""
+        if name == "ground":
+            return self.n_bodies
+        return self.body_names.index(name)
 
     def extra_index(self, name: str, element: str) -> int:
         """Index ``k`` of an extra coordinate (q index ``n_b n_q_body + k``, v index ``n_b n_v_body + k``)."""
@@ -327,14 +334,24 @@ def _compile(model) -> CompiledModel:
         raise NotCompilable(f"model {model.name!r} keeps redundant constraint rows "
                             f"({', '.join(model.redundant_constraints[:3])}...); build it with redundant='remove' "
                             "for the compiled integrators (their Schur complement must be positive definite)")
-    if getattr(model, "flexible", ()):
-        names = ", ".join(f.data.name for f in model.flexible)
-        raise NotCompilable(f"model {model.name!r} has flexible bodies ({names}): their configuration-dependent mass "
-                            "matrix has no compiled form yet; use the numpy integrators")
     layout = Layout(model)
     sp_ = model.space
     nb, dim, nvb = model.n_bodies, sp_.dim, sp_.n_v
     ne = len(model.extra_names)
+    # --- flexible bodies: a rigid block plus modal oscillators (core.flexible.compiled) ----------------
+    flex_blocks, flex_extra_mass, flex_rows = {}, {}, []
+    for f in getattr(model, "flexible", ()):
+        from ..flexible.compiled import compiled_flexible_body
+
+        names = [model.extra_names[int(i) - nb * sp_.n_v] for i in f.vi[nvb:]]
+        try:
+            fb = compiled_flexible_body(f.data, layout, nvb, names)
+        except NotCompilable as exc:
+            raise NotCompilable(f"model {model.name!r}: {exc}") from None
+        flex_blocks[f.body] = fb
+        for c, mu in zip(names, fb["modal_mass"]):
+            flex_extra_mass[model.extra_names.index(c)] = float(mu)
+        flex_rows.append(fb)
     # --- constraint kinds (model row order: primitive kinds, then user constraints) ------------------
     ckinds: list[CompiledConstraints] = []
     row = 0
@@ -343,9 +360,12 @@ def _compile(model) -> CompiledModel:
         if not isinstance(rec, CompiledConstraints):
             raise NotCompilable(f"model {model.name!r}: constraint {_label(kind)!r} returned {type(rec).__name__} "
                                 "from compiled(), expected core.compiled.CompiledConstraints")
-        if rec.slots.shape != (rec.rows, MAX_SLOTS):
+        sl = np.asarray(rec.slots)
+        if sl.ndim != 2 or sl.shape[0] != rec.rows or not 1 <= sl.shape[1] <= MAX_SLOTS:
             raise NotCompilable(f"model {model.name!r}: constraint {_label(kind)!r}: slots have shape "
-                                f"{rec.slots.shape}, expected ({rec.rows}, {MAX_SLOTS})")
+                                f"{sl.shape}, expected ({rec.rows}, w) with 1 <= w <= {MAX_SLOTS}")
+        if sl.shape[1] < MAX_SLOTS:  # a kind that uses fewer slots (e.g. written when MAX_SLOTS was 3)
+            rec.slots = np.hstack([sl, np.full((rec.rows, MAX_SLOTS - sl.shape[1]), -1, sl.dtype)])
         rec._row0 = row  # noqa: SLF001 - bookkeeping of the packer
         row += rec.rows
         ckinds.append(rec)
@@ -367,6 +387,8 @@ def _compile(model) -> CompiledModel:
     nx = 0
     for k, bd in enumerate(model.bodies):
         blk = Mcsr[k * nvb:(k + 1) * nvb, k * nvb:(k + 1) * nvb].toarray()
+        if k in flex_blocks:
+            blk = flex_blocks[k]["mass_block"]
         if not np.all(np.isfinite(blk)):
             raise NotCompilable(f"model {model.name!r}: body {bd.name!r} has a non-finite mass matrix")
         blk_v0[k], blk_w[k] = k * nvb, nvb
@@ -380,7 +402,7 @@ def _compile(model) -> CompiledModel:
     for k in range(ne):
         b = nb + 1 + k
         blk_v0[b], blk_w[b] = nb * nvb + k, 1
-        mass = float(Mcsr[nb * nvb + k, nb * nvb + k])
+        mass = flex_extra_mass.get(k, float(Mcsr[nb * nvb + k, nb * nvb + k]))
         if mass > 0:
             minv[b, 0, 0] = 1.0 / mass
         else:
@@ -476,6 +498,10 @@ def _compile(model) -> CompiledModel:
             raise NotCompilable(f"model {model.name!r}: force element {fk.names[0]!r} returned {type(rec).__name__} "
                                 "from compiled(), expected core.compiled.CompiledForces")
         fkinds.append(rec)
+    if flex_rows:
+        from ..flexible.compiled import modal_force_record
+
+        fkinds.append(modal_force_record(flex_rows, [f.data.name for f in model.flexible]))
     if len(ckinds) > KIND_CAPACITY or len(fkinds) > KIND_CAPACITY:
         raise NotCompilable(f"model {model.name!r} has {len(ckinds)} constraint and {len(fkinds)} force kinds; "
                             f"the compiled path takes at most {KIND_CAPACITY} of each")
@@ -483,6 +509,10 @@ def _compile(model) -> CompiledModel:
     Jt = np.zeros((nb + 1, 3, 3))
     if dim == 3 and nb:
         Jt[:nb] = model._J
+    for k, fb in flex_blocks.items():  # the flexible bodies' rigid part: inertia and weight
+        if dim == 3:
+            Jt[k] = fb["inertia"]
+        Qg[k * nvb:k * nvb + dim] += fb["weight"] * np.asarray(model.gravity, float)
     lay = np.array([nb, dim, sp_.n_q, nvb, model.n_q, model.n_v, ne], np.int64)
     fields = dict(lay=lay, blk_v0=blk_v0, blk_w=blk_w, blk_x=blk_x, minv=minv, Qg=Qg, Jt=Jt, r_blk=r_blk,
                   act=np.asarray(act, np.int64), reg=np.ascontiguousarray(reg_sorted), ext=ext_arr,

@@ -90,8 +90,13 @@ STATUS_MESSAGES = {
 WANT_PHI, WANT_NU, WANT_GAMMA = 1, 2, 4
 WANT_ALL = WANT_PHI | WANT_NU | WANT_GAMMA
 
-#: Blocks a constraint row may touch (two bodies and one extra coordinate, or similar).
-MAX_SLOTS = 3
+#: Blocks a constraint row may touch: two bodies and one extra coordinate (a path joint), or a
+#: flexible body's node frame — the frame, the node body and up to six modes
+#: (:mod:`core.flexible.compiled`).  Rows fill the slots they use; unused slots (−1) cost a skipped
+#: test in the loops over slots.  The compiled functions read it when they are compiled: a change
+#: must come with a change of every file whose jitted code loops over it (numba keys its disk cache
+#: on the function's own file).
+MAX_SLOTS = 8
 
 #: Entries of the layout array ``lay`` passed to every kernel.
 LAYOUT_FIELDS = ("n_bodies", "dim", "n_q_body", "n_v_body", "n_q", "n_v", "n_extra")
@@ -239,8 +244,9 @@ class CompiledConstraints:
     fd, ix : ndarray, 2-D (float64, int64)
     rows : int
         Number of model rows the kind writes (from its ``row0``).
-    slots : ndarray of int, shape (rows, MAX_SLOTS)
-        Block of each Jacobian slot of each row (see the module docstring).
+    slots : ndarray of int, shape (rows, w), w <= MAX_SLOTS
+        Block of each Jacobian slot of each row (see the module docstring); the packer pads
+        narrower arrays with −1 (unused) to ``MAX_SLOTS``.
     names : list of str
         Element names; ``err[1]`` indexes this list.
     time_dependent : bool

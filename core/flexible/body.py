@@ -71,6 +71,24 @@ Gravity follows from the potential :math:`V_g = -g^\mathsf{T}(m r + A\,s(q_f))`,
 :math:`D_{ff} = M_{ff} X\,\mathrm{diag}(2\zeta_k\omega_k) X^\mathsf{T} M_{ff}` with :math:`X` the normal modes of
 :math:`(K_{ff}, M_{ff})`.
 
+Inertia of the undeformed body (option)
+---------------------------------------
+With ``inertia="undeformed"`` the kinetic energy is that of the undeformed body,
+:math:`T_0 = \tfrac12\hat\nu^\mathsf{T}\hat M_0\hat\nu`, :math:`\hat M_0 = D(0)^\mathsf{T}\mathcal M D(0)` constant in
+the body-axes velocities: the same Kirchhoff equations with :math:`\dot D = 0` and
+:math:`\partial T/\partial q_f = 0`.  The deformation then enters the inertia only through the
+constraints of the node frames: the terms of :math:`\mathcal M` linear and quadratic in :math:`q_f`
+(the change of the inertia tensor with the deformation, the Coriolis coupling :math:`2\bar\omega\times
+\Phi\dot q_f`, the centrifugal softening :math:`-\bar\omega^2`-terms on the modes) are dropped, which
+is the linearisation of the inertia about the undeformed state (Shabana 2013, sec. 5.8; the
+"order 0" of the inertia invariants in the SID of Wallrapp 1994).  It is accurate where the
+frame's rotation rates are small against the modal frequencies and the deformation small against
+the body (a railway car body: rates of 0.01–0.1 rad/s against 50–100 rad/s), and it is wrong for
+fast-spinning bodies (the spin-up beam).  With mean-axis modes (free–free,
+``orthonormalized(drop_rigid=True)``) and the frame origin at the centre of mass, :math:`\hat M_0` is
+block diagonal — a rigid body plus one oscillator per mode — which is the form the compiled
+integrators take (:mod:`core.flexible.compiled`).  Gravity keeps its full potential.
+
 Geometric stiffening
 --------------------
 Optional.  The stress of a unit centrifugal load, :math:`f_{ij} = -M_{FE}\,(B_{ij}\bar x)` with
@@ -159,6 +177,9 @@ class FlexibleBodyData:
     source : str
     beam : tuple or None
         ``(mesh, section, theory)`` of a beam component (section forces), else None.
+    inertia : str
+        ``"full"`` (the exact kinetic energy of the deformed body) or ``"undeformed"`` (that of the
+        undeformed body; module docstring).
     """
 
     name: str
@@ -179,6 +200,7 @@ class FlexibleBodyData:
     labels: tuple
     source: str
     beam: tuple | None = None
+    inertia: str = "full"
 
     # --- node kinematics ------------------------------------------------------------------
     def translation_rows(self, node: int) -> Array:
@@ -229,6 +251,8 @@ class FlexibleBodyData:
         d, r, m = self.dim, self.n_rot, self.n_modes
         a = d + r
         V = A.T @ rdot
+        if self.inertia == "undeformed":
+            return self._undeformed_mass_and_forces(A, V, w, qf, qfd, g)
         c = np.concatenate([V, w, np.repeat(qf, r) * np.tile(w, m), qfd])
         D = self._D(qf)
         G = self.gram
@@ -260,7 +284,36 @@ class FlexibleBodyData:
         Mb[:d, :] = A @ Mb[:d, :]
         Mb[:, :d] = Mb[:, :d] @ A.T
         rhs[:d] = A @ rhs[:d]
-        return Mb, rhs
+        return 0.5 * (Mb + Mb.T), rhs  # symmetric to the last bit (the products round differently)
+
+    def undeformed_mass(self) -> Array:
+        """:math:`\\hat M_0 = D(0)^T \\mathcal M D(0)` in the body-axes velocities ``(V̄, ω̄, q̇_f)``."""
+        D0 = self._D(np.zeros(self.n_modes))
+        return D0.T @ self.gram @ D0
+
+    def _undeformed_mass_and_forces(self, A, V, w, qf, qfd, g):
+        """:meth:`mass_and_forces` with the kinetic energy of the undeformed body (``inertia="undeformed"``):
+        Kirchhoff's equations with the constant :math:`\\hat M_0` (module docstring)."""
+        d, r = self.dim, self.n_rot
+        a = d + r
+        Mh = self.undeformed_mass()
+        p = Mh @ np.concatenate([V, w, qfd])
+        h = -Mh[:, :d] @ _w_cross(w, V)
+        h[:d] += _w_cross(w, p[:d])
+        if d == 3:
+            h[d:a] += np.cross(w, p[d:a])
+        h[d:a] += _cross(V, p[:d])
+        gb = A.T @ g
+        F = np.empty(a + self.n_modes)
+        F[:d] = self.mass * gb
+        F[d:a] = _cross(self.first_moment + self.S @ qf, gb)
+        F[a:] = self.S.T @ gb - self.K @ qf - self.D @ qfd
+        rhs = F - h
+        Mb = Mh.copy()
+        Mb[:d, :] = A @ Mb[:d, :]
+        Mb[:, :d] = Mb[:, :d] @ A.T
+        rhs[:d] = A @ rhs[:d]
+        return 0.5 * (Mb + Mb.T), rhs  # symmetric to the last bit (the products round differently)
 
     def potential(self, r: Array, A: Array, qf: Array, g: Array) -> float:
         """Gravitational plus strain energy [J]: ``−gᵀ(m r + A s(q_f)) + ½ q_fᵀ K q_f``."""
@@ -328,6 +381,8 @@ def _rotation_field(nodes: Array, p: int, U: Array, Psi: Array | None, j: int) -
 
 #: the kinds of geometric stiffening (module docstring); True means "centrifugal"
 STIFFENING = ("centrifugal",)
+#: Kinetic energies of a flexible body (module docstring)
+INERTIA = ("full", "undeformed")
 
 
 def _stiffening(name, value) -> bool:
@@ -344,7 +399,7 @@ def _stiffening(name, value) -> bool:
 
 
 def flexible_body_data(name: str, fe: FEModel, modes: ModalComponent, damping_ratio=0.0,
-                       geometric_stiffening=False, dim: int | None = None) -> FlexibleBodyData:
+                       geometric_stiffening=False, dim: int | None = None, inertia: str = "full") -> FlexibleBodyData:
     """Check a component and compute its run-time data (module docstring).
 
     Raises
@@ -355,6 +410,12 @@ def flexible_body_data(name: str, fe: FEModel, modes: ModalComponent, damping_ra
         definite, a damping ratio out of range, geometric stiffening asked of a component without
         a geometric stiffness.
     """
+    if inertia not in INERTIA:
+        from ..inputs import closest
+
+        hint = closest(inertia, INERTIA) if isinstance(inertia, str) else None
+        raise ModelError(f"flexible body {name!r}: inertia={inertia!r}; give one of {', '.join(map(repr, INERTIA))}"
+                         + (f" (did you mean {hint!r}?)" if hint else ""))
     if not isinstance(fe, FEModel):
         raise ModelError(f"flexible body {name!r}: give an FEModel (core.flexible.FEModel), got {type(fe).__name__}")
     if not isinstance(modes, ModalComponent):
@@ -423,13 +484,16 @@ def flexible_body_data(name: str, fe: FEModel, modes: ModalComponent, damping_ra
     # --- geometric stiffening -------------------------------------------------------------------------
     KG = None
     centrifugal = _stiffening(name, geometric_stiffening)
+    if centrifugal and inertia == "undeformed":
+        raise ModelError(f"flexible body {name!r}: geometric stiffening is for fast-spinning bodies, whose inertia "
+                         "changes with the deformation; it cannot be combined with inertia='undeformed'")
     if centrifugal and fe.geometric_stiffness is None:
         raise ModelError(f"flexible body {name!r}: geometric stiffening needs the component's geometric stiffness; "
                          f"{fe.source or 'this FE model'} has none (beam components have it; imported matrices do not)")
     if centrifugal:
         KG = np.array([_unit_geometric_stiffness(name, fe, Mfe, T, B, nodes, p, t_idx) for B in _products_B(d)])
     return FlexibleBodyData(name, d, r, m, gram, mass, first, S, Kr, 0.5 * (Dm + Dm.T), KG, nodes, p, T,
-                            omega / (2.0 * np.pi), tuple(modes.labels), fe.source, fe.beam)
+                            omega / (2.0 * np.pi), tuple(modes.labels), fe.source, fe.beam, inertia)
 
 
 def _damping(name, value, m):
@@ -523,6 +587,12 @@ class FlexibleNodes(UserConstraint):
         self._X = self.data.nodes[self.nodes]
         self._Pt = np.array([self.data.translation_rows(i) for i in self.nodes])
         self._Pr = np.array([self.data.rotation_rows(i) for i in self.nodes])
+
+    def compiled(self, layout):
+        """Compiled form (:func:`core.flexible.compiled.compile_flexible_nodes`)."""
+        from .compiled import compile_flexible_nodes
+
+        return compile_flexible_nodes(self, layout)
 
     # --- helpers -----------------------------------------------------------------------------
     def _split(self, q):

@@ -46,6 +46,10 @@ E. Hairer, S. P. Nørsett, G. Wanner, *Solving Ordinary Differential Equations I
 
 from __future__ import annotations
 
+# numba bakes module constants such as protocol.MAX_SLOTS into its cached machine code and keys the
+# cache on this file only: this file changed with MAX_SLOTS (3 -> 8, flexible bodies' node frames),
+# so that no stale kernel of the old width runs (docs/architecture.md, numba's on-disk cache)
+
 import numba
 import numpy as np
 import scipy.integrate as _si

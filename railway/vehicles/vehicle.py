@@ -146,6 +146,22 @@ class VehicleDefinition:
 
         return cls.from_toml(data_path("railway", "vehicles", "manchester_coach.toml"))
 
+    def with_flexible_car_body(self, **table) -> VehicleDefinition:
+        """This vehicle with its car body flexible: ``table`` is a ``[car_body.flexible]`` table
+        (length, vertical_bending_frequency, torsion_frequency, lateral_bending_frequency,
+        damping_ratio, elements; :mod:`railway.vehicles.vehicle_file`), checked like the file's;
+        the car body's mass and inertia stay (:mod:`railway.vehicles.car_body`)."""
+        from dataclasses import replace
+
+        from .vehicle_file import flexible_car_body
+
+        car_body = dict(self.car_body)
+        car_body["flexible"] = flexible_car_body(table, self.car_body["mass"], self.car_body["inertia"],
+                                                 self.geometry["bogie_centre_semi_distance"],
+                                                 f"vehicle {self.name!r} with_flexible_car_body()", InputError,
+                                                 self.accept)
+        return replace(self, car_body=car_body)
+
     @property
     def total_mass(self) -> float:
         return self.car_body["mass"] + 2 * self.bogie["mass"] + 4 * self.wheelset["mass"]
@@ -190,6 +206,16 @@ class Vehicle:
     preload_table: pd.DataFrame | None = None
     _contact_options: dict | None = None
     start: Any = None
+    #: a flexible car body's node frames by station ("centre", "over bogie 1", "over bogie 2");
+    #: empty for a rigid car body
+    car_body_frames: dict = field(default_factory=dict)
+    #: a flexible car body's equivalent beam (railway.vehicles.car_body.CarBodyBeam), else None
+    car_body_beam: Any = None
+
+    @property
+    def _moving_bodies(self) -> list[str]:
+        """The bodies a start state moves and lowers: car body (and its node frames), bogies, wheelsets."""
+        return [self.car_body] + list(self.car_body_frames.values()) + self.bogies + self.wheelsets
 
     @property
     def on_straight_track(self) -> bool:
@@ -352,7 +378,7 @@ class Vehicle:
         h = hertz_from_load(share / np.cos(res.contact_angle[i, c]), Ac, np.clip(Bc, Ac / 1e3, Ac * 1e3),
                             E, nu, E, nu)
         drop = float(np.mean(h.delta + res.gap[i, c]))
-        for name in [self.car_body] + self.bogies + self.wheelsets:
+        for name in self._moving_bodies:
             q[m.q_slice(name).start + 2] -= drop
         return q
 
@@ -377,7 +403,7 @@ class Vehicle:
         q = self.q_static.copy()
         v = np.zeros(m.n_v)
         wl = np.zeros(4) if wheelset_lateral is None else np.asarray(wheelset_lateral, float)
-        for name in [self.car_body] + self.bogies + self.wheelsets:
+        for name in self._moving_bodies:
             qs, vs = m.q_slice(name), m.v_slice(name)
             r = q[qs][:3]
             s = self.track.project(r[None, :], np.array([self.s0]))
@@ -403,7 +429,7 @@ class Vehicle:
         if not lateral and not yaw and not np.any(wl):
             return q, v
         m = self.model
-        for name in [self.car_body] + self.bogies + self.wheelsets:
+        for name in self._moving_bodies:
             qs = m.q_slice(name)
             r = q[qs][:3]
             s = self.track.project(r[None, :], np.array([self.s0]))
@@ -663,7 +689,18 @@ def build_vehicle(definition: VehicleDefinition, track, s0: float, speed: float 
         return pos, R
 
     cb = "car body"
-    add(cb, D.car_body, s0, lateral, g["car_body_cg_height"] + dz1 + dz2)
+    flex = D.car_body.get("flexible")
+    if flex is None:
+        add(cb, D.car_body, s0, lateral, g["car_body_cg_height"] + dz1 + dz2)
+        frames_cb, beam = {}, None
+    else:
+        frames_cb, beam = _add_flexible_car_body(b, D, cb, straight, place, s0, lateral,
+                                                 g["car_body_cg_height"] + dz1 + dz2, speed)
+
+    def cb_at(k):
+        """The car-body end of the suspension of bogie k: the body, or the node frame over the
+        bogie centre of a flexible car body."""
+        return frames_cb.get(f"over bogie {k + 1}", cb)
     bogies = ["bogie 1", "bogie 2"]
     for k, nm in enumerate(bogies):
         add(nm, D.bogie, s_b[k], lateral, g["bogie_cg_height"] + dz1)
@@ -696,24 +733,24 @@ def build_vehicle(definition: VehicleDefinition, track, s0: float, speed: float 
         for side, y in (("left", ys), ("right", -ys)):
             P = point(cb, s0, s_b[k] - s0, y, hs + dz1 + dz2)
             Q = point(bg, s_b[k], 0.0, y, hs + dz1)
-            b.add_bushing(f"secondary {k + 1} {side}", cb, bg, at=P, point_j=Q,
+            b.add_bushing(f"secondary {k + 1} {side}", cb_at(k), bg, at=P, point_j=Q,
                           translational_stiffness=D.secondary["stiffness"],
                           rotational_stiffness=(0.0, 0.0, D.secondary["yaw_stiffness"]),
                           translational_damping=D.secondary["damping"], rotational_damping=0.0, axes=R)
         P = point(cb, s0, s_b[k] - s0, 0.0, hs + dz1 + dz2)
         Q = point(bg, s_b[k], 0.0, 0.0, hs + dz1)
         if D.anti_roll_bar > 0:
-            b.add_bushing(f"anti-roll bar {k + 1}", cb, bg, at=P, point_j=Q, translational_stiffness=0.0,
+            b.add_bushing(f"anti-roll bar {k + 1}", cb_at(k), bg, at=P, point_j=Q, translational_stiffness=0.0,
                           rotational_stiffness=(D.anti_roll_bar, 0.0, 0.0), axes=R)
         if D.bump_stop is not None:
-            b.add_bump_stop(f"lateral bump stop {k + 1}", cb, bg, at=P, axis=R[:, 1],
+            b.add_bump_stop(f"lateral bump stop {k + 1}", cb_at(k), bg, at=P, axis=R[:, 1],
                             table=np.column_stack([D.bump_stop["displacement"], D.bump_stop["force"]]), point_j=Q)
         for j, yd in enumerate(D.yaw_dampers):
             for side, sgn in (("left", 1.0), ("right", -1.0)):
                 # longitudinal damper: car body end x ahead of the bogie centre, bogie end at it
                 P = point(cb, s0, s_b[k] - s0 + yd["x"], sgn * yd["y"], yd["z"] + dz1 + dz2)
                 Q = point(bg, s_b[k], 0.0, sgn * yd["y"], yd["z"] + dz1)
-                b.add_series_spring_damper(f"yaw damper {k + 1}.{j + 1} {side}", cb, bg, P, Q,
+                b.add_series_spring_damper(f"yaw damper {k + 1}.{j + 1} {side}", cb_at(k), bg, P, Q,
                                            stiffness=yd["series_stiffness"], damping=yd["damping"],
                                            node_mass=yd["node_mass"])
     if parking:
@@ -740,4 +777,28 @@ def build_vehicle(definition: VehicleDefinition, track, s0: float, speed: float 
         model = _place_on_track(model, on_track, speed)
     return Vehicle(definition=D, model=model, track=track, car_body=cb, bogies=bogies, wheelsets=wheelsets,
                    contact=contact, s0=float(s0), speed=float(speed), creep_law=creep_law,
-                   _contact_options=contact_options)
+                   _contact_options=contact_options, car_body_frames=frames_cb, car_body_beam=beam)
+
+
+def _add_flexible_car_body(b, D, cb, straight, place, s0, lateral, z, speed):
+    """The car body of ``[car_body.flexible]`` (:mod:`railway.vehicles.car_body`): a flexible body
+    with the undeformed inertia at the centre of mass, and node frames at the car-body centre and
+    over both bogie centres; returns their names by station and the equivalent beam."""
+    from .car_body import car_body_beam
+
+    if not straight:
+        raise InputError(f"build_vehicle: vehicle {D.name!r} has a flexible car body, which starts on straight "
+                         f"track only (the quasi-static curving start of a flexible body is not built yet); "
+                         f"place it where the track under it is straight (s0 = {s0:g} m is not)")
+    fx = D.car_body["flexible"]
+    L_b = D.geometry["bogie_centre_semi_distance"]
+    beam = car_body_beam(D.car_body["mass"], D.car_body["inertia"], fx["length"], [0.0, L_b, -L_b],
+                         fx["vertical_bending_frequency"], fx.get("torsion_frequency"),
+                         fx.get("lateral_bending_frequency"), fx.get("elements", 24), where=f"{D.name!r} car body")
+    pos, R = place(s0, lateral, z)
+    b.add_flexible_body(cb, beam.fe, beam.modes, position=pos, orientation=frames.matrix_to_euler(R),
+                        velocity=speed * R[:, 0], damping_ratio=fx["damping_ratio"], inertia="undeformed")
+    names = {}
+    for label, x in (("centre", 0.0), ("over bogie 1", L_b), ("over bogie 2", -L_b)):
+        names[label] = b.add_node_frame(cb, beam.stations[float(x)], name=f"{cb} {label}")
+    return names, beam

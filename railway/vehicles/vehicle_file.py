@@ -24,7 +24,10 @@ relative to the vehicle file), rail ("UIC60" or a file), inclination ("1:40", "1
 bogie_centre_semi_distance, bogie_semi_wheelbase, primary_lateral_semi_spacing,
 secondary_lateral_semi_spacing, car_body_cg_height, bogie_cg_height, secondary_height (heights
 above the rail top); ``[car_body]``, ``[bogie]``, ``[wheelset]`` mass, inertia (about x, y, z: a
-list of 3, or one number for all three); ``[primary]`` stiffness, damping (x, y, z per axlebox);
+list of 3, or one number for all three); optional ``[car_body.flexible]`` (a flexible car body,
+:mod:`railway.vehicles.car_body`): length, vertical_bending_frequency, optional torsion_frequency
+and lateral_bending_frequency (free–free, in Hz; a string in rad/s is refused), damping_ratio
+(default 0.02, or "2 %"), elements (default 24); ``[primary]`` stiffness, damping (x, y, z per axlebox);
 ``[secondary]`` stiffness, damping (x, y, z per side), yaw_stiffness (per side, default 0);
 optional ``[anti_roll_bar]`` stiffness (per bogie); optional ``[lateral_bump_stop]``
 displacement, force (first row the clearance at 0 N); optional ``[[yaw_damper]]`` damping,
@@ -196,9 +199,40 @@ class Geometry(InputModel):
 _ROT = "roll, pitch, yaw"
 
 
+def F(qname: str):
+    """A frequency field [Hz]: as :func:`Q`, refusing angular-frequency units (pint reads '60 rad/s'
+    as 60 Hz: it drops the 2π)."""
+    def _v(value, info: ValidationInfo):
+        if isinstance(value, str) and "rad" in value:
+            raise ValueError(f"{value!r}: give the frequency in Hz (cycles per second); an angular frequency "
+                             "in rad/s would be read without its 2π")
+        return _checked(qname, value, _accept(info))
+
+    return Annotated[float, BeforeValidator(_v)]
+
+
+def _elements(value):
+    if isinstance(value, bool) or not isinstance(value, int) or not 4 <= value <= 400:
+        raise ValueError(f"must be a whole number of beam elements from 4 to 400, got {value!r}")
+    return value
+
+
+class FlexibleCarBody(InputModel):
+    """``[car_body.flexible]``: the car body as a free–free equivalent beam
+    (:mod:`railway.vehicles.car_body`)."""
+
+    length: Q("car_body_length")
+    vertical_bending_frequency: F("car_body_bending_frequency")
+    torsion_frequency: Optional[F("car_body_torsion_frequency")] = None
+    lateral_bending_frequency: Optional[F("car_body_lateral_bending_frequency")] = None
+    damping_ratio: Q("car_body_damping_ratio", zero_ok=True) = 0.02
+    elements: Annotated[int, BeforeValidator(_elements)] = 24
+
+
 class CarBody(InputModel):
     mass: Q("car_body_mass")
     inertia: V(["car_body_roll_inertia", "car_body_pitch_inertia", "car_body_yaw_inertia"], what=_ROT)
+    flexible: Optional[FlexibleCarBody] = None
 
 
 class Bogie(InputModel):
@@ -439,6 +473,11 @@ def vehicle_kwargs(data: dict, *, source: str = "vehicle definition", base_dir=N
     def body(b):
         return {"mass": b.mass, "inertia": np.array(b.inertia, dtype=float)}
 
+    car_body = body(vf.car_body)
+    if vf.car_body.flexible is not None:
+        car_body["flexible"] = _flexible_rules(vf.car_body.flexible, vf.car_body.mass, vf.car_body.inertia,
+                                               g["bogie_centre_semi_distance"], source, error)
+
     def susp(s):
         return {"stiffness": np.array(s.stiffness, dtype=float), "damping": np.array(s.damping, dtype=float)}
 
@@ -465,10 +504,37 @@ def vehicle_kwargs(data: dict, *, source: str = "vehicle definition", base_dir=N
     name = vf.vehicle.name if vf.vehicle.name is not None else Path(str(source)).stem
     return dict(name=name, source=vf.vehicle.source, wheel=wheel, rail=rail, inclination=pr.inclination,
                 gauge=pr.gauge, r0=pr.nominal_wheel_radius, flange_back_spacing=pr.flange_back_spacing,
-                geometry=g, car_body=body(vf.car_body), bogie=body(vf.bogie), wheelset=body(vf.wheelset),
+                geometry=g, car_body=car_body, bogie=body(vf.bogie), wheelset=body(vf.wheelset),
                 primary=susp(vf.primary), secondary=secondary,
                 anti_roll_bar=vf.anti_roll_bar.stiffness if vf.anti_roll_bar is not None else 0.0,
                 bump_stop=bump, yaw_dampers=yds, accept=tuple(acc))
+
+
+def _flexible_rules(fx: FlexibleCarBody, m, J, L_b, source, error) -> dict:
+    """The ``[car_body.flexible]`` table's consistency with the rest of the vehicle: the body
+    reaches over the bogie centres, and its pitch and yaw inertias are at least the uniform beam's."""
+    if fx.length <= 2 * L_b:
+        raise error(f"{source} [car_body.flexible] length = {fx.length:g} m does not reach over the bogie centres "
+                    f"(2 bogie_centre_semi_distance = {2 * L_b:g} m): the car body is longer than its bogie distance")
+    for k, axis in ((1, "pitch"), (2, "yaw")):
+        if J[k] < m * fx.length**2 / 12.0 * (1 - 1e-12):
+            raise error(f"{source} [car_body] inertia: the {axis} inertia {J[k]:.4g} kg m^2 is below that of a "
+                        f"uniform beam of the car body's mass over [car_body.flexible] length {fx.length:g} m "
+                        f"(m L^2/12 = {m * fx.length**2 / 12:.4g} kg m^2): the flexible car body's mass cannot "
+                        f"be spread over that length; give a length of at most {np.sqrt(12 * J[k] / m):.4g} m")
+    return fx.model_dump()
+
+
+def flexible_car_body(table: dict, mass, inertia, bogie_centre_semi_distance, source, error=InputError,
+                      accept=()) -> dict:
+    """A ``[car_body.flexible]`` table checked as in a vehicle file (schema, units, ranges, rules),
+    as a dict of SI values (:meth:`railway.vehicles.vehicle.VehicleDefinition.with_flexible_car_body`)."""
+    if not isinstance(table, dict):
+        raise error(f"{source}: the flexible car body must be a table of keys, got {table!r}")
+    fx = validate(FlexibleCarBody, table, source=f"{source} [car_body.flexible]", context={"accept": list(accept)},
+                  error=error)
+    return _flexible_rules(fx, float(mass), np.asarray(inertia, float), float(bogie_centre_semi_distance), source,
+                           error)
 
 
 def read_vehicle_file(path, accept=()) -> dict:

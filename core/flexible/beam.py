@@ -70,7 +70,7 @@ from ..errors import InputError
 from ..inputs import parse_quantity
 
 __all__ = ["BeamGeometricStiffness", "BeamMesh", "BeamSection", "beam_matrices", "geometric_stiffness",
-           "section_forces", "straight_beam", "SECTION_FORCES", "THEORIES"]
+           "section_forces", "fibre_stresses", "straight_beam", "SECTION_FORCES", "THEORIES"]
 
 THEORIES = ("euler-bernoulli", "timoshenko")
 
@@ -92,6 +92,9 @@ class BeamSection:
     J : torsion constant [m^4]; default ``Iy + Iz`` (a circular section)
     Ip : polar second moment for the rotary inertia of torsion [m^4]; default ``Iy + Iz``
     shear_factor : Timoshenko's shear coefficient kappa [-]; default 5/6 (a rectangle)
+    outline : the section's shape for fibre stresses, ``("rectangle", width, height)`` or
+        ``("circle", diameter)`` [m]; set by :meth:`rectangle` and :meth:`circle`, None for a section
+        given by its properties only (:func:`fibre_stresses` then refuses)
     accept : quantities whose plausible range (``data/core/flexible_plausible_ranges.csv``) is not
         enforced, e.g. ``("E",)`` for a deliberately soft material; otherwise a value outside is
         refused with the likely unit slip named
@@ -108,6 +111,7 @@ class BeamSection:
     Ip: float | None = None
     shear_factor: float = 5.0 / 6.0
     accept: tuple = ()
+    outline: tuple | None = None
 
     def __post_init__(self):
         from .ranges import checked
@@ -136,6 +140,14 @@ class BeamSection:
         for name in ("J", "Ip"):
             if getattr(self, name) is None:
                 object.__setattr__(self, name, self.Iy + self.Iz)
+        if self.outline is not None:
+            o = tuple(self.outline)
+            sizes = {"rectangle": 2, "circle": 1}
+            if not (o and o[0] in sizes and len(o) == 1 + sizes[o[0]]
+                    and all(isinstance(x, (int, float)) and np.isfinite(x) and x > 0 for x in o[1:])):
+                raise InputError(f"beam section outline = {self.outline!r}: give ('rectangle', width, height) or "
+                                 "('circle', diameter) in m, positive")
+            object.__setattr__(self, "outline", (o[0],) + tuple(float(x) for x in o[1:]))
 
     @classmethod
     def rectangle(cls, E, rho, width, height, **kw) -> BeamSection:
@@ -149,7 +161,8 @@ class BeamSection:
         long, short = max(b, h), min(b, h)
         # Young & Budynas, Roark's Formulas for Stress and Strain, 7th ed., table 10.7 case 4
         J = long * short**3 * (1.0 / 3.0 - 0.21 * short / long * (1.0 - short**4 / (12.0 * long**4)))
-        return cls(E=E, rho=rho, A=b * h, Iz=h * b**3 / 12.0, Iy=b * h**3 / 12.0, J=kw.pop("J", J), **kw)
+        return cls(E=E, rho=rho, A=b * h, Iz=h * b**3 / 12.0, Iy=b * h**3 / 12.0, J=kw.pop("J", J),
+                   outline=("rectangle", float(b), float(h)), **kw)
 
     @classmethod
     def circle(cls, E, rho, diameter, **kw) -> BeamSection:
@@ -160,7 +173,7 @@ class BeamSection:
         d = checked("thickness", diameter, "circle diameter", kw.get("accept", ()))
         nu = parse_quantity(kw.get("nu", 0.3), "1", where="beam section nu")
         kw.setdefault("shear_factor", 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu))
-        return cls(E=E, rho=rho, A=np.pi * d**2 / 4.0, Iz=np.pi * d**4 / 64.0, **kw)
+        return cls(E=E, rho=rho, A=np.pi * d**2 / 4.0, Iz=np.pi * d**4 / 64.0, outline=("circle", float(d)), **kw)
 
 
 @dataclass(frozen=True)
@@ -331,6 +344,48 @@ def section_forces(mesh: BeamMesh, section: BeamSection, u, theory: str = "euler
         f = _element_rotation(mesh, e) @ (Ke @ ue)
         out[e, 0], out[e, 1] = -f[:n], f[n:]
     return out
+
+
+def fibre_stresses(mesh: BeamMesh, section: BeamSection, u, theory: str = "euler-bernoulli") -> np.ndarray:
+    r"""Largest and smallest normal stress over the section at both ends of every element (Navier).
+
+    From the section forces (:func:`section_forces`) and the section's outline: the normal stress
+    of axial force and bending, :math:`\sigma = N/A - M_z y/I_z + M_y z/I_y`, at its extreme fibres,
+
+    * rectangle b × h (local y × z): :math:`\sigma_{max,min} = N/A \pm (|M_z|\,b/(2I_z) +
+      |M_y|\,h/(2I_y))`, reached at a corner; in the plane :math:`N/A \pm |M|\,b/(2I_z)`;
+    * circle of diameter d: :math:`N/A \pm \sqrt{M_y^2 + M_z^2}\,d/(2I)` (the bending axis turns
+      with the moment vector);
+
+    (Young & Budynas, *Roark's Formulas for Stress and Strain*, 7th ed., sec. 8.1).  Shear stresses
+    of V and T are not included.
+
+    Returns
+    -------
+    (n_el, 2, 2) ndarray
+        Per element and end (i, j): (σ_max, σ_min) [Pa].
+
+    Raises
+    ------
+    InputError
+        A section without an outline (made from its properties only).
+    """
+    if section.outline is None:
+        raise InputError("fibre stresses need the section's outline: make the section with BeamSection.rectangle "
+                         "or BeamSection.circle (or give outline=('rectangle', width, height) / ('circle', d))")
+    sf = section_forces(mesh, section, u, theory)
+    N = sf[..., 0]
+    kind = section.outline[0]
+    if mesh.dim == 2:
+        c = section.outline[1] / 2.0  # the width along local y (bending in the x–y plane)
+        bend = np.abs(sf[..., 2]) * c / section.Iz
+    elif kind == "rectangle":
+        b, h = section.outline[1], section.outline[2]
+        bend = np.abs(sf[..., 5]) * b / (2.0 * section.Iz) + np.abs(sf[..., 4]) * h / (2.0 * section.Iy)
+    else:
+        bend = np.hypot(sf[..., 4], sf[..., 5]) * section.outline[1] / (2.0 * section.Iz)
+    axial = N / section.A
+    return np.stack([axial + bend, axial - bend], axis=-1)
 
 
 def element_matrices(mesh: BeamMesh, section: BeamSection, e: int, theory: str = "euler-bernoulli"):

@@ -231,6 +231,18 @@ class FlexibleBodyData:
         mesh, section, theory = self.beam
         return section_forces(mesh, section, self.T @ np.asarray(qf, float), theory)
 
+    def fibre_stresses(self, qf: Array) -> Array:
+        """Largest and smallest normal stress over the section at both ends of every beam element
+        for the modal coordinates ``qf`` (:func:`core.flexible.beam.fibre_stresses`: (n_el, 2, 2),
+        σ_max and σ_min [Pa]); needs a beam component whose section has an outline."""
+        if self.beam is None:
+            raise ModelError(f"flexible body {self.name!r}: fibre stresses need a beam component; "
+                             f"{self.source or 'this component'} is not one (use node_displacements)")
+        from .beam import fibre_stresses
+
+        mesh, section, theory = self.beam
+        return fibre_stresses(mesh, section, self.T @ np.asarray(qf, float), theory)
+
     # --- dynamics ---------------------------------------------------------------------------
     def _D(self, qf: Array) -> Array:
         d, r, m = self.dim, self.n_rot, self.n_modes

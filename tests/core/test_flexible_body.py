@@ -288,6 +288,55 @@ def test_section_forces_of_a_cantilever_under_a_tip_load(dim):
     np.testing.assert_allclose(data.section_forces(modes.T.T @ (fe.M @ u)), sf, atol=1e-6)
 
 
+@pytest.mark.parametrize("dim,shape", [(2, "rectangle"), (3, "rectangle"), (3, "circle")])
+def test_fibre_stresses_of_a_cantilever_under_a_tip_load(dim, shape):
+    """Navier at the extreme fibres: a cantilever of length L with a tip load P across it and an
+    axial pull F has σ = F/A ± P (L − x) c / I (c the extreme fibre distance in the bending plane);
+    for the rectangle in space a load with components along both section axes puts the extreme at
+    a corner, F/A ± (P_y (L − x) b/(2 I_z) + P_z (L − x) h/(2 I_y)).  Statics: exact (1e-6 relative)."""
+    import scipy.sparse.linalg as spla
+
+    from core.flexible.beam import fibre_stresses
+
+    L, n = 2.0, 8
+    sec = (BeamSection.rectangle(E=7e10, rho=2700.0, width=0.04, height=0.02) if shape == "rectangle"
+           else BeamSection.circle(E=7e10, rho=2700.0, diameter=0.03))
+    mesh = straight_beam(L, n, dim=dim, orientation=(0.0, 1.0, 0.0))  # local y = global y, local z = global z
+    fe = FEModel.from_beam(mesh, sec)
+    free = np.setdiff1d(np.arange(fe.n_dofs), fe.dofs(0))
+    F, Py, Pz = 300.0, 40.0, (25.0 if dim == 3 else 0.0)
+    f = np.zeros(fe.n_dofs)
+    f[fe.dofs(n)[:dim]] = [F, Py] + ([Pz] if dim == 3 else [])
+    u = np.zeros(fe.n_dofs)
+    u[free] = spla.spsolve(fe.K[free][:, free].tocsc(), f[free])
+    sig = fibre_stresses(mesh, sec, u)
+    x = np.linspace(0.0, L, n + 1)[:-1]  # end i of every element
+    if shape == "circle":
+        bend = np.hypot(Py, Pz) * (L - x) * sec.outline[1] / (2 * sec.Iz)
+    else:
+        b, h = sec.outline[1], sec.outline[2]
+        bend = Py * (L - x) * b / (2 * sec.Iz) + Pz * (L - x) * h / (2 * sec.Iy)
+    np.testing.assert_allclose(sig[:, 0, 0], F / sec.A + bend, rtol=1e-6)
+    np.testing.assert_allclose(sig[:, 0, 1], F / sec.A - bend, rtol=1e-6)
+    modes = normal_mode_component(fe.M, fe.K, fe.n_dofs - len(fe.dofs(0)), fixed_dofs=fe.dofs(0))
+    b_ = ModelBuilder(dim, "cantilever")
+    b_.add_flexible_body("beam", fe, modes)
+    data = b_.build().flexible[0].data
+    np.testing.assert_allclose(data.fibre_stresses(modes.T.T @ (fe.M @ u)), sig, rtol=1e-6, atol=1e-3)
+
+
+def test_fibre_stresses_need_an_outline():
+    from core.errors import InputError
+    from core.flexible.beam import fibre_stresses
+
+    mesh = straight_beam(1.0, 2)
+    fe = FEModel.from_beam(mesh, SECTION)
+    with pytest.raises(InputError, match="fibre stresses need the section's outline"):
+        fibre_stresses(mesh, SECTION, np.zeros(fe.n_dofs))
+    with pytest.raises(InputError, match="outline = \\('square', 0.1\\)"):
+        BeamSection(E=7e10, rho=2700.0, A=1e-4, Iz=1e-8, outline=("square", 0.1))
+
+
 # --------------------------------------------------------------------------------------------
 # spin-up beam (Kane, Ryan & Banerjee 1987)
 # --------------------------------------------------------------------------------------------

@@ -223,25 +223,25 @@ class FlexibleBodyData:
         """Section forces at both ends of every beam element for the modal coordinates ``qf``
         (:func:`core.flexible.beam.section_forces`: (n_el, 2, 3) in the plane, (n_el, 2, 6) in
         space, N, V, M [N, N m]); :class:`ModelError` for a component that is not made of beams."""
-        if self.beam is None:
-            raise ModelError(f"flexible body {self.name!r}: section forces need a beam component; "
-                             f"{self.source or 'this component'} is not one (use node_displacements)")
         from .beam import section_forces
 
-        mesh, section, theory = self.beam
-        return section_forces(mesh, section, self.T @ np.asarray(qf, float), theory)
+        return self._beam_result(section_forces, "section forces", qf)
 
     def fibre_stresses(self, qf: Array) -> Array:
         """Largest and smallest normal stress over the section at both ends of every beam element
         for the modal coordinates ``qf`` (:func:`core.flexible.beam.fibre_stresses`: (n_el, 2, 2),
         σ_max and σ_min [Pa]); needs a beam component whose section has an outline."""
-        if self.beam is None:
-            raise ModelError(f"flexible body {self.name!r}: fibre stresses need a beam component; "
-                             f"{self.source or 'this component'} is not one (use node_displacements)")
         from .beam import fibre_stresses
 
+        return self._beam_result(fibre_stresses, "fibre stresses", qf)
+
+    def _beam_result(self, fn, what: str, qf: Array) -> Array:
+        """``fn(mesh, section, u, theory)`` of a beam component at the modal coordinates ``qf``."""
+        if self.beam is None:
+            raise ModelError(f"flexible body {self.name!r}: {what} need a beam component; "
+                             f"{self.source or 'this component'} is not one (use node_displacements)")
         mesh, section, theory = self.beam
-        return fibre_stresses(mesh, section, self.T @ np.asarray(qf, float), theory)
+        return fn(mesh, section, self.T @ np.asarray(qf, float), theory)
 
     # --- dynamics ---------------------------------------------------------------------------
     def _D(self, qf: Array) -> Array:

@@ -55,8 +55,12 @@ table = pd.DataFrame(rows)
 # The ratio of the two car bodies' N_MV at the centre against speed; the speed where it first
 # passes 1.1 is bisected in the full run (to 0.25 m/s), between the grid speeds where it does.
 def centre_ratio(rows_of_speed, column="N_MV [-]"):
+    """flexible / rigid at the car-body centre; NaN unless both runs finished (a failed run's
+    partial record is in the table with its message, not in the ratio)."""
     t = pd.DataFrame(rows_of_speed)
     t = t[t["floor point"] == "centre"].set_index("car body")
+    if column not in t or not (t["status"] != "failed").all():
+        return float("nan")
     return float(t.loc["flexible", column] / t.loc["rigid", column])
 
 
@@ -79,8 +83,11 @@ if scene.full and above and above[0] != speeds[0]:
         rows_mid = [row for r, _ in pair for row in r]
         r_mid = centre_ratio(rows_mid)
         summary.loc[len(summary)] = (mid, r_mid, centre_ratio(rows_mid, "a_ZP95 Wb [m/s2]"))
+        if not np.isfinite(r_mid):  # a failed run: stop the bisection and say where
+            break
         lo, hi = (mid, hi) if r_mid <= 1.1 else (lo, mid)
-    crossing = 0.5 * (lo + hi)
+    else:
+        crossing = 0.5 * (lo + hi)
 summary = summary.sort_values("speed [m/s]").reset_index(drop=True)
 scene.table("comfort_ratio", summary)
 
@@ -126,11 +133,16 @@ a2.grid(True, alpha=0.3)
 a2.legend(fontsize=7, ncol=2)
 scene.figure("mean_comfort_against_speed", fig2)
 
+failed = [r for r in rows if r["status"] == "failed"]
+if failed:
+    scene.note(f"{len(failed)} floor-point rows come from failed runs (their messages are in the table); their "
+               "speeds have no ratio, and a bisection that met one stopped there.")
 where = (f"The flexible car body's N_MV at the centre first exceeds the rigid one's by 10 % at {crossing:.2f} m/s "
          f"(bisected to 0.25 m/s between the grid speeds)." if crossing is not None else
          "The ratio of N_MV at the centre, flexible to rigid, is in the table comfort_ratio; "
          + ("`--full` bisects the speed where it passes 1.1." if not scene.full else
-            "it does not pass 1.1 between two grid speeds here."))
+            ("the bisection stopped at a failed run (above)." if failed else
+             "it does not pass 1.1 between two grid speeds here.")))
 scene.note(
     f"The Manchester coach over the same irregular straight track (ORE B176 low level as quoted, seed 1, "
     f"wavelengths 3-70 m) at {', '.join(f'{v:g}' for v in speeds)} m/s, Polach 2000, {METHOD} rtol {RTOL:g}, "

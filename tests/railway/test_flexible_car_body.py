@@ -172,3 +172,17 @@ def test_flexible_car_body_in_a_curve_is_refused_by_name():
         build_vehicle(D, curving_track(), s0=150.0, speed=10.0)
     with pytest.raises(InputError, match="with_flexible_car_body.*vertical_bending_frequency"):
         VehicleDefinition.manchester().with_flexible_car_body(length=24.0, vertical_bending_frequncy=9.0)
+
+
+def test_the_guides_flexible_table_reads(tmp_path):
+    """The ```toml block of docs/user-guide/railway-vehicles.md (units as strings, comments) is a
+    valid [car_body.flexible] table for the Manchester coach."""
+    import re
+
+    from core.paths import repo_root
+
+    page = (repo_root() / "docs" / "user-guide" / "railway-vehicles.md").read_text(encoding="utf-8")
+    block = re.search(r"```toml\n\[car_body\.flexible\]\n(.*?)```", page, re.S).group(1)
+    fx = VehicleDefinition.from_toml(_file(tmp_path, block)).car_body["flexible"]
+    assert fx == {"length": 24.0, "vertical_bending_frequency": 9.0, "torsion_frequency": 12.0,
+                  "lateral_bending_frequency": 15.0, "damping_ratio": 0.02, "elements": 24}

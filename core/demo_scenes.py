@@ -33,6 +33,12 @@ SCENES = [
                   "Slider crank with an elastic rod: published model, flexible body and rigid-link rod",
                   "Simeon (1996); Test Set for IVP Solvers 'crank'.",
                   full_adds="16 elements and 5 modes; rigid-link rods of 16 and 32 links."),
+    example_scene("sar-antenna", "core/sar_antenna.py",
+                  "SAR antenna unfolding: actuator moments with rigid and flexible panels",
+                  "After Anantharaman & Hiller (1991) and Ambrósio's review (Figs 27-28), all data assumed; "
+                  "one panel against the exact cantilever modes.",
+                  full_adds="a grid of deployment times, the bisected time where the flexible moments exceed "
+                            "the rigid ones by 10 %, and two fixed-interface modes per panel."),
     # the work-precision report is part of the main job (``make run``)
     example_scene("work-precision", "core/work_precision.py",
                   "Work-precision: error against run time for every integrator",

@@ -9,7 +9,8 @@ A :class:`TimeFunction` returns the value and its first two time derivatives,
 * :func:`tabulated` interpolates measured data (e.g. joint angles of a gait trial) with a
   twice-differentiable cubic spline (:class:`scipy.interpolate.CubicSpline`), whose derivatives
   are exact for the interpolant.
-* :func:`polynomial`, :func:`ramp` and :func:`harmonic` are common closed forms.
+* :func:`polynomial`, :func:`ramp` and :func:`harmonic` are common closed forms; :func:`cycloidal`
+  is the cam designer's rest-to-rest law (a deployment, a move between two positions).
 
 The closed forms and tables carry a ``spec`` (kind and parameters) from which the compiled path
 (:mod:`core.compiled.timefunctions`) evaluates the same function in numba; a :func:`motion` of a
@@ -156,6 +157,59 @@ def harmonic(amplitude: float, omega: float, phase: float = 0.0, offset: float =
         f"{amplitude}·sin({omega}t+{phase})",
         spec=("harmonic", float(amplitude), float(omega), float(phase), float(offset)),
     )
+
+
+class _Cycloidal:
+    """Derivative ``order`` of the cycloidal rest-to-rest law (:func:`cycloidal`)."""
+
+    def __init__(self, change, duration, start, order):
+        self.h, self.T, self.t0, self.order = change, duration, start, order
+
+    def __call__(self, t):
+        tau = (t - self.t0) / self.T
+        if tau <= 0.0:
+            return 0.0
+        if tau >= 1.0:
+            return self.h if self.order == 0 else 0.0
+        c = 2.0 * np.pi
+        if self.order == 0:
+            return self.h * (tau - np.sin(c * tau) / c)
+        if self.order == 1:
+            return self.h / self.T * (1.0 - np.cos(c * tau))
+        return self.h * c / self.T**2 * np.sin(c * tau)
+
+
+def cycloidal(change: float, duration: float, start: float = 0.0) -> TimeFunction:
+    r"""The cycloidal rest-to-rest law: ``f`` moves by ``change`` in ``duration`` seconds from ``start``.
+
+    With :math:`\tau = (t - t_0)/T` (Norton, *Design of Machinery*, cam design, the cycloidal
+    displacement),
+
+    .. math::
+
+        f = h\,\Big(\tau - \frac{\sin 2\pi\tau}{2\pi}\Big),\qquad
+        \dot f = \frac{h}{T}\,(1 - \cos 2\pi\tau),\qquad
+        \ddot f = \frac{2\pi h}{T^2}\,\sin 2\pi\tau \qquad (0 \le \tau \le 1),
+
+    ``f = 0`` before and ``f = h`` after.  ``change`` is in the driven coordinate's SI unit (rad or
+    m), or a string with its unit (``"90 deg"``); ``duration`` and ``start`` in s or with a unit.
+    Velocity and acceleration are continuous (zero at both ends); the jerk jumps at both ends.  Peak velocity ``2h/T``, peak acceleration ``2πh/T²``.
+    Evaluated in Python only: a driver using it keeps a model on the numpy right-hand side.
+    """
+    from .inputs import UnitError, parse_quantity
+
+    if isinstance(change, str):  # "90 deg" for an angle driver, "0.2 m" for a point driver
+        try:
+            h = parse_quantity(change, "rad", where="cycloidal change")
+        except UnitError:
+            h = parse_quantity(change, "m", where="cycloidal change (an angle or a length)")
+    else:
+        h = parse_quantity(change, "1", where="cycloidal change")
+    T = parse_quantity(duration, "s", where="cycloidal duration")
+    t0 = parse_quantity(start, "s", where="cycloidal start")
+    if not T > 0.0:
+        raise InputError(f"cycloidal: duration = {duration!r} must be a positive time")
+    return TimeFunction(*(_Cycloidal(h, T, t0, k) for k in range(3)), f"cycloidal {h:g} in {T:g} s from {t0:g} s")
 
 
 def tabulated(times, values, label: str = "table", bc_type: str = "not-a-knot",

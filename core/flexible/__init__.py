@@ -15,9 +15,10 @@ nodes where joints and forces attach.  This package makes those components:
   free-interface modes with static correction (residual attachment modes with inertia relief),
   into a :class:`~core.flexible.reduction.ModalComponent`.
 
-Still to come (issue 23): the floating-frame body kind in the core's absolute coordinates (inertia
-invariants, quadratic-velocity and elastic forces, geometric stiffening, markers on nodes), HDF5
-import.
+The floating-frame body kind itself is :mod:`core.flexible.body` (and, for mean-axis bodies with
+the undeformed inertia, :mod:`core.flexible.compiled`); :mod:`core.flexible.models` holds the
+canonical models (spin-up beam, elastic slider crank, SAR antenna) with their independent
+references.  Not here: HDF5 import (Matrix Market only).
 """
 
 from .beam import BeamMesh, BeamSection, beam_matrices, straight_beam

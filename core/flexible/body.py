@@ -180,6 +180,11 @@ class FlexibleBodyData:
     inertia : str
         ``"full"`` (the exact kinetic energy of the deformed body) or ``"undeformed"`` (that of the
         undeformed body; module docstring).
+    stress_modes : (N, n_components, n_modes) ndarray or None
+        Nodal stresses [Pa per unit modal coordinate] of each mode, for plane and solid components
+        (:class:`core.flexible.continuum.ContinuumStresses`), else None.
+    stress_components : tuple of str
+        The names of the stress components (``σ_xx`` …), empty without stress modes.
     """
 
     name: str
@@ -201,6 +206,8 @@ class FlexibleBodyData:
     source: str
     beam: tuple | None = None
     inertia: str = "full"
+    stress_modes: Array | None = None
+    stress_components: tuple = ()
 
     # --- node kinematics ------------------------------------------------------------------
     def translation_rows(self, node: int) -> Array:
@@ -234,6 +241,23 @@ class FlexibleBodyData:
         from .beam import fibre_stresses
 
         return self._beam_result(fibre_stresses, "fibre stresses", qf)
+
+    def nodal_stresses(self, qf: Array) -> Array:
+        """Stresses at the nodes [Pa] for the modal coordinates ``qf``, shape (N, n_components), the
+        components named by :attr:`stress_components`: the modal stresses summed,
+        σ = Σ_k σ_k q_k (plane and solid components; beams have :meth:`fibre_stresses`)."""
+        if self.stress_modes is None:
+            other = "use fibre_stresses or section_forces" if self.beam is not None else "imported matrices carry none"
+            raise ModelError(f"flexible body {self.name!r}: nodal stresses need a plane or solid component; "
+                             f"{self.source or 'this component'} is not one ({other})")
+        return self.stress_modes @ np.asarray(qf, float)
+
+    def von_mises_stresses(self, qf: Array) -> Array:
+        """Von Mises equivalent stress [Pa] at every node for the modal coordinates ``qf``, shape (N,)
+        (:func:`core.flexible.continuum.von_mises` of :meth:`nodal_stresses`)."""
+        from .continuum import von_mises
+
+        return von_mises(self.nodal_stresses(qf))
 
     def _beam_result(self, fn, what: str, qf: Array) -> Array:
         """``fn(mesh, section, u, theory)`` of a beam component at the modal coordinates ``qf``."""
@@ -504,8 +528,13 @@ def flexible_body_data(name: str, fe: FEModel, modes: ModalComponent, damping_ra
                          f"{fe.source or 'this FE model'} has none (beam components have it; imported matrices do not)")
     if centrifugal:
         KG = np.array([_unit_geometric_stiffness(name, fe, Mfe, T, B, nodes, p, t_idx) for B in _products_B(d)])
+    stress_modes, components = None, ()
+    if fe.stress_recovery is not None:
+        stress_modes = np.asarray(fe.stress_recovery(T), float)
+        components = tuple(fe.stress_recovery.components)
     return FlexibleBodyData(name, d, r, m, gram, mass, first, S, Kr, 0.5 * (Dm + Dm.T), KG, nodes, p, T,
-                            omega / (2.0 * np.pi), tuple(modes.labels), fe.source, fe.beam, inertia)
+                            omega / (2.0 * np.pi), tuple(modes.labels), fe.source, fe.beam, inertia,
+                            stress_modes, components)
 
 
 def _damping(name, value, m):
@@ -609,7 +638,7 @@ class FlexibleNodes(UserConstraint):
     # --- helpers -----------------------------------------------------------------------------
     def _split(self, q):
         sp_ = self.space
-        k, m = len(self.nodes), self.data.n_modes
+        k = len(self.nodes)
         qq = q[self.q_index]
         ref = qq[:sp_.n_q]
         nod = qq[sp_.n_q:sp_.n_q * (k + 1)].reshape(k, sp_.n_q)

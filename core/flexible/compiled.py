@@ -27,7 +27,6 @@ import numpy as np
 
 from ..compiled.protocol import (
     L_DIM,
-    L_NB,
     MAX_SLOTS,
     OK,
     WANT_GAMMA,

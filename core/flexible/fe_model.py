@@ -34,7 +34,9 @@ class FEModel:
     the stress stiffness in the stress state of the displacement ``u`` (beams:
     :class:`~core.flexible.beam.BeamGeometricStiffness`); flexible bodies use it for geometric
     stiffening.  Imported matrices have none.  ``beam`` is ``(mesh, section, theory)`` for a beam
-    component (section forces are recovered from it), else None."""
+    component (section forces are recovered from it), else None.  ``stress_recovery``, for plane and
+    solid components, is a callable ``U -> σ`` giving the nodal stresses of displacement columns
+    (:class:`~core.flexible.continuum.ContinuumStresses`), else None."""
 
     nodes: np.ndarray
     dofs_per_node: int
@@ -43,6 +45,7 @@ class FEModel:
     source: str = ""
     geometric_stiffness: object = None
     beam: tuple | None = None
+    stress_recovery: object = None
 
     def __post_init__(self):
         n = self.nodes.shape[0] * self.dofs_per_node

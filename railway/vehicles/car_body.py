@@ -45,6 +45,16 @@ the car-body centre and at both bogie centres; the secondary suspension, anti-ro
 stops and yaw dampers attach to the node frames over the bogie centres at their file offsets
 (a rigid lever from the beam axis), and the ride-comfort floor points are read at the three
 nodes (:func:`railway.comfort`).
+
+An imported FE model
+--------------------
+The table may instead name the car body maker's FE model (:func:`imported_car_body`): mass and
+stiffness in Matrix Market files, nodes in a CSV, read by :meth:`core.flexible.FEModel.read` with
+their units.  Its nodes are moved so that the centre of mass (from the mass matrix) is the origin;
+its lowest free–free elastic modes are kept (mean axes, so the same undeformed-inertia body and the
+compiled integrators apply), and the node frames go on the three nodes the table names.  Its mass
+and inertias must agree with the file's ``[car_body]`` (1 % and 5 %): the two describe one body,
+and a disagreement is a unit slip or a wrong file far more often than a modelling choice.
 """
 
 from __future__ import annotations
@@ -55,7 +65,7 @@ import numpy as np
 
 from core.errors import InputError
 
-__all__ = ["CarBodyBeam", "car_body_beam", "FAMILIES"]
+__all__ = ["CarBodyBeam", "FAMILIES", "ImportedCarBody", "car_body_beam", "imported_car_body"]
 
 #: Mode families of the beam, in the order the file names them, with the node dof indices that
 #: carry their kinetic energy (u_x, u_y, u_z, θ_x, θ_y, θ_z)
@@ -212,3 +222,148 @@ def car_body_beam(mass, inertia, length, stations, vertical_bending, torsion=Non
                  (mesh, stiff_sec, "timoshenko"))
     stations_idx = {float(s): int(np.argmin(np.abs(x - s))) for s in st}
     return CarBodyBeam(fe, modes, stations_idx, {k: float(f[first[k]]) for k in given}, dict(stiffness))
+
+
+@dataclass(frozen=True)
+class ImportedCarBody:
+    """A flexible car body from an FE model exported by another code (:func:`imported_car_body`).
+
+    Attributes
+    ----------
+    fe : core.flexible.FEModel
+        The component, its nodes moved so that the origin is its centre of mass.
+    modes : core.flexible.ModalComponent
+        The lowest free–free elastic modes (mass-normalised, mean axes).
+    stations : dict of str to int
+        Node index of the car-body centre and of the nodes over bogie 1 and bogie 2.
+    frequencies : dict of str to float
+        Frequency [Hz] of each kept mode (``"mode 1"`` …).
+    mass : float
+        [kg] of the FE model.
+    inertia : (3,) ndarray
+        Roll, pitch, yaw inertia about its centre of mass [kg m²].
+    centre_of_mass : (3,) ndarray
+        Where the centre of mass lay in the file's coordinates [m].
+    """
+
+    fe: object
+    modes: object
+    stations: dict
+    frequencies: dict
+    mass: float
+    inertia: np.ndarray
+    centre_of_mass: np.ndarray
+
+
+#: how far the mass and the inertias of an imported car body may lie from the vehicle file's
+#: [car_body] values before the two are refused as contradicting each other
+MASS_TOLERANCE, INERTIA_TOLERANCE = 0.01, 0.05
+#: how far [m] along the body a node named as over a bogie centre (or the centre) may lie from it
+STATION_TOLERANCE = 0.25
+#: the most modes of an imported car body: the compiled integrators take up to six
+MAX_IMPORTED_MODES = 6
+#: plausible first elastic frequency [Hz] of a car body; far outside it the units were likely wrong
+FIRST_MODE_RANGE = (1.0, 60.0)
+
+
+def _rigid_properties(nodes, p, M):
+    """Mass, centre of mass and inertia tensor about it of a component with ``p`` dofs per node."""
+    N = nodes.shape[0]
+    Pt = np.zeros((N * p, 3))
+    for k in range(3):
+        Pt[k::p, k] = 1.0
+    MPt = M @ Pt
+    mass = float(np.trace(Pt.T @ MPt) / 3.0)
+    x0 = np.zeros(N * p)
+    for k in range(3):
+        x0[k::p] = nodes[:, k]
+    com = (MPt.T @ x0) / mass
+    d = nodes - com
+    Rot = np.zeros((N * p, 3))
+    for k in range(3):
+        u = np.cross(np.eye(3)[k], d)  # small rotation about axis k through the centre of mass
+        for j in range(3):
+            Rot[j::p, k] = u[:, j]
+        if p == 6:
+            Rot[3 + k::6, k] = 1.0
+    J = Rot.T @ (M @ Rot)
+    return mass, com, 0.5 * (J + J.T)
+
+
+def imported_car_body(mass_matrix, stiffness_matrix, nodes, centre_node: int, bogie_nodes, mass, inertia,
+                      bogie_centre_semi_distance, n_modes: int = 4, dofs_per_node: int = 6, length_unit="m",
+                      mass_unit="kg", force_unit="N", where="car body") -> ImportedCarBody:
+    """A flexible car body from an exported FE model: mass and stiffness in Matrix Market files and
+    node coordinates in a CSV (:meth:`core.flexible.FEModel.read`, units converted).
+
+    The FE model's axes are the car body's: x forward (towards bogie 1), y to the left, z up; its
+    origin may be anywhere (the nodes are moved so that the centre of mass is the origin, the body
+    frame of the vehicle).  It must be free (six rigid-body modes).  Its lowest ``n_modes`` elastic
+    free–free modes are kept (mean axes, so the compiled integrators take the body), and node
+    frames are put on ``centre_node`` and on ``bogie_nodes`` (over bogie 1, over bogie 2): node
+    numbers are rows of the node file counting from 0.
+
+    Checked, each refused with the files and values named: the FE model's mass and inertias
+    against the vehicle file's ``[car_body]`` (within :data:`MASS_TOLERANCE` and
+    :data:`INERTIA_TOLERANCE`: one of the two is wrong, often a unit); the stations' nodes within
+    :data:`STATION_TOLERANCE` of x = 0 and x = ±L_b from the centre of mass; the first elastic
+    frequency within :data:`FIRST_MODE_RANGE`; at most :data:`MAX_IMPORTED_MODES` modes.
+    """
+    from core.flexible import FEModel, free_interface
+
+    if not (isinstance(n_modes, (int, np.integer)) and 1 <= n_modes <= MAX_IMPORTED_MODES):
+        raise InputError(f"{where}: modes = {n_modes!r}; keep 1 to {MAX_IMPORTED_MODES} elastic modes (the compiled "
+                         "integrators take up to six; the lowest few carry the ride-comfort response)")
+    if dofs_per_node not in (3, 6):
+        raise InputError(f"{where}: dofs_per_node = {dofs_per_node!r}; a spatial car body has 3 (translations) "
+                         "or 6 (with rotations) degrees of freedom per node")
+    fe = FEModel.read(mass_matrix, stiffness_matrix, nodes, dofs_per_node, length_unit, mass_unit, force_unit)
+    X = fe.nodes
+    if X.shape[1] != 3:
+        raise InputError(f"{where}: node file {nodes} gives {X.shape[1]} coordinates per node; a car body needs "
+                         "x, y, z")
+    N, p = X.shape[0], fe.dofs_per_node
+    picks = [centre_node, *list(bogie_nodes)]
+    if len(picks) != 3:
+        raise InputError(f"{where}: bogie_nodes must name two nodes (over bogie 1 and over bogie 2), got "
+                         f"{list(bogie_nodes)!r}")
+    for k in picks:
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < N:
+            raise InputError(f"{where}: node {k!r} is not a row of node file {nodes} (0 to {N - 1}, counting "
+                             "from 0)")
+    m_fe, com, Jt = _rigid_properties(X, p, fe.M)
+    m, J = float(mass), np.asarray(inertia, float)
+    if abs(m_fe / m - 1.0) > MASS_TOLERANCE:
+        decades = np.log10(m_fe / m)
+        hint = (f" (a mass_unit slip? they differ by a factor of 10^{round(decades)})"
+                if round(decades) != 0 and abs(decades - round(decades)) < 0.01 else "")
+        raise InputError(f"{where}: the FE model ({mass_matrix}) has a mass of {m_fe:.6g} kg, the vehicle file's "
+                         f"[car_body] mass is {m:.6g} kg{hint}; they must agree within {MASS_TOLERANCE:.0%}")
+    for k, axis in enumerate(("roll", "pitch", "yaw")):
+        if abs(Jt[k, k] / J[k] - 1.0) > INERTIA_TOLERANCE:
+            raise InputError(f"{where}: the FE model's {axis} inertia about its centre of mass is "
+                             f"{Jt[k, k]:.6g} kg m², the vehicle file's [car_body] inertia {J[k]:.6g} kg m²; they "
+                             f"must agree within {INERTIA_TOLERANCE:.0%} (are the FE model's axes x forward, y left, "
+                             "z up?)")
+    Xc = X - com
+    L_b = float(bogie_centre_semi_distance)
+    for label, k, x in (("centre_node", centre_node, 0.0), ("bogie_nodes[0] (over bogie 1)", bogie_nodes[0], L_b),
+                        ("bogie_nodes[1] (over bogie 2)", bogie_nodes[1], -L_b)):
+        if abs(Xc[k, 0] - x) > STATION_TOLERANCE:
+            raise InputError(f"{where}: {label} = {k} lies at x = {Xc[k, 0]:.4g} m from the centre of mass, not within "
+                             f"{STATION_TOLERANCE:g} m of {x:g} m (bogie 1 is ahead, +x; node numbers count from 0)")
+    comp = free_interface(fe.M, fe.K, Xc, p, n_modes)
+    if comp.n_rigid != 6:
+        raise InputError(f"{where}: the FE model ({stiffness_matrix}) has {comp.n_rigid} rigid-body modes; a free "
+                         "car body has six (export it without supports)")
+    modes = comp.orthonormalized(drop_rigid=True)
+    f = modes.frequencies()
+    lo, hi = FIRST_MODE_RANGE
+    if not lo <= f[0] <= hi:
+        raise InputError(f"{where}: the FE model's first elastic mode is at {f[0]:.4g} Hz, outside {lo:g} to {hi:g} Hz "
+                         f"of car bodies; check length_unit, mass_unit and force_unit ({length_unit}, {mass_unit}, "
+                         f"{force_unit})")
+    fe_c = FEModel(Xc, p, fe.M, fe.K, fe.source)
+    stations = {"centre": int(centre_node), "over bogie 1": int(bogie_nodes[0]), "over bogie 2": int(bogie_nodes[1])}
+    return ImportedCarBody(fe_c, modes, stations, {f"mode {k + 1}": float(v) for k, v in enumerate(f)}, m_fe,
+                           np.diag(Jt).copy(), com)

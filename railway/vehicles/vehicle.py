@@ -209,8 +209,17 @@ class Vehicle:
     #: a flexible car body's node frames by station ("centre", "over bogie 1", "over bogie 2");
     #: empty for a rigid car body
     car_body_frames: dict = field(default_factory=dict)
-    #: a flexible car body's equivalent beam (railway.vehicles.car_body.CarBodyBeam), else None
-    car_body_beam: Any = None
+    #: a flexible car body's component: the equivalent beam (railway.vehicles.car_body.CarBodyBeam)
+    #: or the imported FE model (railway.vehicles.car_body.ImportedCarBody); None for a rigid one
+    car_body_component: Any = None
+
+    @property
+    def car_body_beam(self):
+        """The flexible car body's equivalent beam (:class:`railway.vehicles.car_body.CarBodyBeam`),
+        else None (a rigid car body, or one imported from an FE model: :attr:`car_body_component`)."""
+        from .car_body import CarBodyBeam
+
+        return self.car_body_component if isinstance(self.car_body_component, CarBodyBeam) else None
 
     @property
     def _moving_bodies(self) -> list[str]:
@@ -777,13 +786,14 @@ def build_vehicle(definition: VehicleDefinition, track, s0: float, speed: float 
         model = _place_on_track(model, on_track, speed)
     return Vehicle(definition=D, model=model, track=track, car_body=cb, bogies=bogies, wheelsets=wheelsets,
                    contact=contact, s0=float(s0), speed=float(speed), creep_law=creep_law,
-                   _contact_options=contact_options, car_body_frames=frames_cb, car_body_beam=beam)
+                   _contact_options=contact_options, car_body_frames=frames_cb, car_body_component=beam)
 
 
 def _add_flexible_car_body(b, D, cb, straight, place, s0, lateral, z, speed):
     """The car body of ``[car_body.flexible]`` (:mod:`railway.vehicles.car_body`): a flexible body
     with the undeformed inertia at the centre of mass, and node frames at the car-body centre and
-    over both bogie centres; returns their names by station and the equivalent beam."""
+    over both bogie centres; returns their names by station and the component (the equivalent beam
+    or the imported FE model)."""
     from .car_body import car_body_beam
 
     if not straight:
@@ -792,13 +802,22 @@ def _add_flexible_car_body(b, D, cb, straight, place, s0, lateral, z, speed):
                          f"place it where the track under it is straight (s0 = {s0:g} m is not)")
     fx = D.car_body["flexible"]
     L_b = D.geometry["bogie_centre_semi_distance"]
-    beam = car_body_beam(D.car_body["mass"], D.car_body["inertia"], fx["length"], [0.0, L_b, -L_b],
-                         fx["vertical_bending_frequency"], fx.get("torsion_frequency"),
-                         fx.get("lateral_bending_frequency"), fx.get("elements", 24), where=f"{D.name!r} car body")
+    where = f"{D.name!r} car body"
+    if fx.get("mass_matrix") is not None:  # an FE model exported by another code
+        from .car_body import imported_car_body
+
+        body = imported_car_body(fx["mass_matrix"], fx["stiffness_matrix"], fx["nodes"], fx["centre_node"],
+                                 fx["bogie_nodes"], D.car_body["mass"], D.car_body["inertia"], L_b, fx["modes"],
+                                 fx["dofs_per_node"], fx["length_unit"], fx["mass_unit"], fx["force_unit"], where=where)
+        nodes = body.stations
+    else:
+        body = car_body_beam(D.car_body["mass"], D.car_body["inertia"], fx["length"], [0.0, L_b, -L_b],
+                             fx["vertical_bending_frequency"], fx.get("torsion_frequency"),
+                             fx.get("lateral_bending_frequency"), fx.get("elements", 24), where=where)
+        nodes = {label: body.stations[float(x)]
+                 for label, x in (("centre", 0.0), ("over bogie 1", L_b), ("over bogie 2", -L_b))}
     pos, R = place(s0, lateral, z)
-    b.add_flexible_body(cb, beam.fe, beam.modes, position=pos, orientation=frames.matrix_to_euler(R),
+    b.add_flexible_body(cb, body.fe, body.modes, position=pos, orientation=frames.matrix_to_euler(R),
                         velocity=speed * R[:, 0], damping_ratio=fx["damping_ratio"], inertia="undeformed")
-    names = {}
-    for label, x in (("centre", 0.0), ("over bogie 1", L_b), ("over bogie 2", -L_b)):
-        names[label] = b.add_node_frame(cb, beam.stations[float(x)], name=f"{cb} {label}")
-    return names, beam
+    names = {label: b.add_node_frame(cb, node, name=f"{cb} {label}") for label, node in nodes.items()}
+    return names, body

@@ -27,7 +27,11 @@ above the rail top); ``[car_body]``, ``[bogie]``, ``[wheelset]`` mass, inertia (
 list of 3, or one number for all three); optional ``[car_body.flexible]`` (a flexible car body,
 :mod:`railway.vehicles.car_body`): length, vertical_bending_frequency, optional torsion_frequency
 and lateral_bending_frequency (free–free, in Hz; a string in rad/s is refused), damping_ratio
-(default 0.02, or "2 %"), elements (default 24); ``[primary]`` stiffness, damping (x, y, z per axlebox);
+(default 0.02, or "2 %"), elements (default 24) -- or, instead of the beam, an FE model exported by
+another code: mass_matrix, stiffness_matrix (Matrix Market), nodes (CSV), dofs_per_node (3 or 6,
+default 6), length_unit, mass_unit, force_unit (defaults m, kg, N), modes (1 to 6, default 4),
+centre_node and bogie_nodes (rows of the node file from 0), damping_ratio
+(:func:`railway.vehicles.car_body.imported_car_body`); ``[primary]`` stiffness, damping (x, y, z per axlebox);
 ``[secondary]`` stiffness, damping (x, y, z per side), yaw_stiffness (per side, default 0);
 optional ``[anti_roll_bar]`` stiffness (per bogie); optional ``[lateral_bump_stop]``
 displacement, force (first row the clearance at 0 N); optional ``[[yaw_damper]]`` damping,
@@ -217,16 +221,45 @@ def _elements(value):
     return value
 
 
-class FlexibleCarBody(InputModel):
-    """``[car_body.flexible]``: the car body as a free–free equivalent beam
-    (:mod:`railway.vehicles.car_body`)."""
+def _node(value):
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise ValueError(f"must be a node number (a row of the node file, counting from 0), got {value!r}")
+    return value
 
-    length: Q("car_body_length")
-    vertical_bending_frequency: F("car_body_bending_frequency")
+
+def _unit_name(value):
+    if not isinstance(value, str) or not value.strip():
+        raise ValueError(f"must be a unit name such as 'm', 'mm', 'kg', 't', 'N', got {value!r}")
+    return value
+
+
+#: keys of ``[car_body.flexible]`` for the equivalent beam and for an imported FE model
+BEAM_KEYS = ("length", "vertical_bending_frequency", "torsion_frequency", "lateral_bending_frequency", "elements")
+IMPORT_KEYS = ("mass_matrix", "stiffness_matrix", "nodes", "dofs_per_node", "length_unit", "mass_unit", "force_unit",
+               "modes", "centre_node", "bogie_nodes")
+_IMPORT_REQUIRED = ("mass_matrix", "stiffness_matrix", "nodes", "centre_node", "bogie_nodes")
+
+
+class FlexibleCarBody(InputModel):
+    """``[car_body.flexible]``: the car body as a free–free equivalent beam, or an FE model exported
+    by another code (:mod:`railway.vehicles.car_body`); one or the other."""
+
+    length: Optional[Q("car_body_length")] = None
+    vertical_bending_frequency: Optional[F("car_body_bending_frequency")] = None
     torsion_frequency: Optional[F("car_body_torsion_frequency")] = None
     lateral_bending_frequency: Optional[F("car_body_lateral_bending_frequency")] = None
     damping_ratio: Q("car_body_damping_ratio", zero_ok=True) = 0.02
     elements: Annotated[int, BeforeValidator(_elements)] = 24
+    mass_matrix: Optional[str] = None
+    stiffness_matrix: Optional[str] = None
+    nodes: Optional[str] = None
+    dofs_per_node: int = 6
+    length_unit: Annotated[str, BeforeValidator(_unit_name)] = "m"
+    mass_unit: Annotated[str, BeforeValidator(_unit_name)] = "kg"
+    force_unit: Annotated[str, BeforeValidator(_unit_name)] = "N"
+    modes: int = 4
+    centre_node: Optional[Annotated[int, BeforeValidator(_node)]] = None
+    bogie_nodes: Optional[list[Annotated[int, BeforeValidator(_node)]]] = None
 
 
 class CarBody(InputModel):
@@ -476,7 +509,7 @@ def vehicle_kwargs(data: dict, *, source: str = "vehicle definition", base_dir=N
     car_body = body(vf.car_body)
     if vf.car_body.flexible is not None:
         car_body["flexible"] = _flexible_rules(vf.car_body.flexible, vf.car_body.mass, vf.car_body.inertia,
-                                               g["bogie_centre_semi_distance"], source, error)
+                                               g["bogie_centre_semi_distance"], source, error, base)
 
     def susp(s):
         return {"stiffness": np.array(s.stiffness, dtype=float), "damping": np.array(s.damping, dtype=float)}
@@ -510,9 +543,42 @@ def vehicle_kwargs(data: dict, *, source: str = "vehicle definition", base_dir=N
                 bump_stop=bump, yaw_dampers=yds, accept=tuple(acc))
 
 
-def _flexible_rules(fx: FlexibleCarBody, m, J, L_b, source, error) -> dict:
-    """The ``[car_body.flexible]`` table's consistency with the rest of the vehicle: the body
-    reaches over the bogie centres, and its pitch and yaw inertias are at least the uniform beam's."""
+def _flexible_rules(fx: FlexibleCarBody, m, J, L_b, source, error, base=None) -> dict:
+    """The ``[car_body.flexible]`` table's consistency: the equivalent beam's keys or an imported FE
+    model's, not both.  A beam reaches over the bogie centres, and its pitch and yaw inertias are at
+    least the uniform beam's; an imported model is read and checked against ``[car_body]``
+    (:func:`railway.vehicles.car_body.imported_car_body`), its file names resolved against
+    ``base`` (the vehicle file's folder)."""
+    given = fx.model_fields_set
+    beam = [k for k in BEAM_KEYS if k in given]
+    imported = [k for k in IMPORT_KEYS if k in given]
+    w = f"{source} [car_body.flexible]"
+    if beam and imported:
+        raise error(f"{w}: give either the equivalent beam ({', '.join(BEAM_KEYS[:2])}, ...) or an imported FE model "
+                    f"({', '.join(_IMPORT_REQUIRED)}, ...), not both; found {beam[0]!r} and {imported[0]!r}")
+    if imported:
+        missing = [k for k in _IMPORT_REQUIRED if k not in given]
+        if missing:
+            raise error(f"{w}: an imported FE model needs {', '.join(_IMPORT_REQUIRED)}; missing {', '.join(missing)}")
+        from .car_body import imported_car_body
+
+        out = fx.model_dump()
+        for k in ("mass_matrix", "stiffness_matrix", "nodes"):
+            path = Path(out[k])
+            out[k] = str(path if path.is_absolute() or base is None else Path(base) / path)
+        try:
+            imported_car_body(out["mass_matrix"], out["stiffness_matrix"], out["nodes"], out["centre_node"],
+                              out["bogie_nodes"], m, J, L_b, out["modes"], out["dofs_per_node"], out["length_unit"],
+                              out["mass_unit"], out["force_unit"], where=w)
+        except InputError as exc:
+            raise error(str(exc) if str(exc).startswith(w) else f"{w}: {exc}") from None
+        for k in BEAM_KEYS:
+            out.pop(k)
+        return out
+    for k in BEAM_KEYS[:2]:
+        if k not in given:
+            raise error(f"{w}: the equivalent beam needs length and vertical_bending_frequency (or give an imported "
+                        f"FE model: {', '.join(_IMPORT_REQUIRED)}); missing {k}")
     if fx.length <= 2 * L_b:
         raise error(f"{source} [car_body.flexible] length = {fx.length:g} m does not reach over the bogie centres "
                     f"(2 bogie_centre_semi_distance = {2 * L_b:g} m): the car body is longer than its bogie distance")
@@ -522,7 +588,10 @@ def _flexible_rules(fx: FlexibleCarBody, m, J, L_b, source, error) -> dict:
                         f"uniform beam of the car body's mass over [car_body.flexible] length {fx.length:g} m "
                         f"(m L^2/12 = {m * fx.length**2 / 12:.4g} kg m^2): the flexible car body's mass cannot "
                         f"be spread over that length; give a length of at most {np.sqrt(12 * J[k] / m):.4g} m")
-    return fx.model_dump()
+    out = fx.model_dump()
+    for k in IMPORT_KEYS:
+        out.pop(k)
+    return out
 
 
 def flexible_car_body(table: dict, mass, inertia, bogie_centre_semi_distance, source, error=InputError,

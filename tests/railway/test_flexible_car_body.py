@@ -186,3 +186,100 @@ def test_the_guides_flexible_table_reads(tmp_path):
     fx = VehicleDefinition.from_toml(_file(tmp_path, block)).car_body["flexible"]
     assert fx == {"length": 24.0, "vertical_bending_frequency": 9.0, "torsion_frequency": 12.0,
                   "lateral_bending_frequency": 15.0, "damping_ratio": 0.02, "elements": 24}
+
+
+# --- an imported car-body FE model ([car_body.flexible] mass_matrix, stiffness_matrix, nodes) -----------
+
+#: the centre of mass in the exported model's coordinates: their origin at the body's rear end, at
+#: rail height 1.8 m below the centre of mass (the import must find the centre of mass itself)
+OFFSET = np.array([12.0, 0.0, 1.8])
+
+
+def _export(tmp_path, mass_scale=1.0):
+    """The equivalent beam of the assumed 9/12/15 Hz car body written as another FE code would: Matrix
+    Market mass and stiffness, a node CSV with a header, the origin at the body's rear end."""
+    from scipy.io import mmwrite
+
+    beam = car_body_beam(MASS, INERTIA, 24.0, [0.0, L_B, -L_B], 9.0, 12.0, 15.0)
+    mmwrite(str(tmp_path / "carbody_M.mtx"), beam.fe.M * mass_scale, symmetry="symmetric")
+    mmwrite(str(tmp_path / "carbody_K.mtx"), beam.fe.K, symmetry="symmetric")
+    X = beam.fe.nodes + OFFSET
+    (tmp_path / "carbody_nodes.csv").write_text("x,y,z\n" + "\n".join(",".join(f"{v:.17g}" for v in r) for r in X))
+    st = beam.stations
+    return beam, st[0.0], [st[L_B], st[-L_B]]
+
+
+def _import_table(centre, bogies, extra=""):
+    return (f'mass_matrix = "carbody_M.mtx"\nstiffness_matrix = "carbody_K.mtx"\nnodes = "carbody_nodes.csv"\n'
+            f"modes = 3\ncentre_node = {centre}\nbogie_nodes = {bogies}\n{extra}")
+
+
+def test_an_imported_car_body_is_the_same_body_as_its_equivalent_beam(tmp_path):
+    """The equivalent beam exported and read back through a vehicle file: the same mass, inertia and
+    free–free frequencies (to round-off), its centre of mass found where the export put it."""
+    from railway.vehicles.car_body import imported_car_body
+
+    beam, centre, bogies = _export(tmp_path)
+    D = VehicleDefinition.from_toml(_file(tmp_path, _import_table(centre, bogies)))
+    fx = D.car_body["flexible"]
+    assert fx["modes"] == 3 and "length" not in fx
+    body = imported_car_body(fx["mass_matrix"], fx["stiffness_matrix"], fx["nodes"], fx["centre_node"],
+                             fx["bogie_nodes"], MASS, INERTIA, L_B, fx["modes"])
+    np.testing.assert_allclose(body.centre_of_mass, OFFSET, atol=1e-9)
+    assert body.mass == pytest.approx(MASS, rel=1e-12)
+    np.testing.assert_allclose(body.inertia, INERTIA, rtol=1e-9)
+    np.testing.assert_allclose(sorted(body.frequencies.values()), [9.0, 12.0, 15.0], rtol=1e-9)
+    assert body.stations == {"centre": centre, "over bogie 1": bogies[0], "over bogie 2": bogies[1]}
+
+
+def test_an_imported_car_body_rides_as_its_equivalent_beam(tmp_path):
+    """Over 0.6 s of irregular track at 30 m/s, the car body over the leading bogie moves the same with
+    the imported model as with the [car_body.flexible] beam table it was exported from (the same modes,
+    so the difference is the integration error at rtol 1e-7)."""
+    from railway.contact.creep import creep_law_for_runs
+    from railway.vehicles.ride import irregularities
+
+    _, centre, bogies = _export(tmp_path)
+    V = 30.0
+    track = Track.straight(160.0, irregularities=irregularities(160.0, seed=1))
+    cl, cp = creep_law_for_runs("polach2000", V)
+    z = {}
+    for label, D in (("beam", VehicleDefinition.manchester().with_flexible_car_body(**ASSUMED_FLEXIBLE_CAR_BODY)),
+                     ("imported", VehicleDefinition.from_toml(_file(
+                         tmp_path, _import_table(centre, bogies, 'damping_ratio = "2 %"'))))):
+        veh = build_vehicle(D, track, s0=40.0, speed=V, creep_law=cl, creep_params=cp, speed_control=V)
+        veh.preload()
+        q0, v0 = veh.initial_state()
+        res = simulate(veh.model, (0.0, 0.6), "jit-dop853", q0=q0, v0=v0, rtol=1e-7, atol=1e-9, n_output=61)
+        assert res.success, res.message
+        z[label] = res.q[:, veh.model.q_slice(veh.car_body_frames["over bogie 1"]).start + 2]
+    assert np.ptp(z["beam"]) > 1e-4  # the body does move
+    assert np.max(np.abs(z["imported"] - z["beam"])) < 1e-4 * np.ptp(z["beam"])
+
+
+@pytest.mark.parametrize("case,match", [
+    ("mass in t", r"mass of 3\.2e\+07 kg.*32000 kg.*mass_unit slip.*10\^3"),
+    ("off by one", r"bogie_nodes\[0\] \(over bogie 1\) = .* lies at x = "),
+    ("both", "either the equivalent beam .* or an imported FE model .* not both"),
+    ("missing key", "missing centre_node"),
+    ("missing file", "does not exist"),
+    ("seven modes", "modes = 7"),
+    ("node out of range", "node 999 is not a row"),
+    ("axes swapped", r"roll inertia about its centre of mass .* axes x forward"),
+])
+def test_careless_imports_are_refused_by_name(tmp_path, case, match):
+    _, centre, bogies = _export(tmp_path, mass_scale=1000.0 if case == "mass in t" else 1.0)
+    table = {"mass in t": _import_table(centre, bogies),
+             "off by one": _import_table(centre, [bogies[0] + 1, bogies[1]]),
+             "both": _import_table(centre, bogies, "length = 24.0"),
+             "missing key": _import_table(centre, bogies).replace(f"centre_node = {centre}\n", ""),
+             "missing file": _import_table(centre, bogies).replace("carbody_K.mtx", "carbody_K2.mtx"),
+             "seven modes": _import_table(centre, bogies).replace("modes = 3", "modes = 7"),
+             "node out of range": _import_table(centre, [999, bogies[1]]),
+             "axes swapped": _import_table(centre, bogies)}[case]
+    if case == "axes swapped":  # the body's length written along y
+        nodes = tmp_path / "carbody_nodes.csv"
+        rows = [r.split(",") for r in nodes.read_text().splitlines()[1:]]
+        nodes.write_text("y,x,z\n" + "\n".join(",".join([r[1], r[0], r[2]]) for r in rows))
+    with pytest.raises((DataFileError, InputError), match=match):
+        VehicleDefinition.from_toml(_file(tmp_path, table))

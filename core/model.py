@@ -777,13 +777,13 @@ class Model(ConstrainedSystem):
         self._M_flex_pos = [np.asarray(pos[np.repeat(f.vi, len(f.vi)), np.tile(f.vi, len(f.vi))]).ravel().astype(np.int64) - 1
                             for f in recs]
 
-    def _flexible_terms(self, q: Array, v: Array | None):
-        """Per flexible body ``(M_b, Q_b)`` at ``(q, v)`` (v None: zero velocities)."""
+    def _flexible_terms(self, q: Array, v: Array):
+        """Per flexible body ``(M_b, Q_b)`` at ``(q, v)``."""
         out = []
         d = self.space.dim
         for f in self.flexible:
             qb = q[f.qi]
-            vb = np.zeros(len(f.vi)) if v is None else v[f.vi]
+            vb = v[f.vi]
             nqb, nvb = self.space.n_q, self.space.n_v
             A = self.space.rotation(qb[None, :nqb])[0]
             out.append(f.data.mass_and_forces(A, vb[:d], vb[d:nvb], qb[nqb:], vb[nvb:], self.gravity))
@@ -888,7 +888,10 @@ class Model(ConstrainedSystem):
         if not self.flexible:
             return self._M
         data = self._M_base.copy()
-        for (Mb, _), pos in zip(self._flexible_terms(q, None), self._M_flex_pos):
+        nqb = self.space.n_q
+        for f, pos in zip(self.flexible, self._M_flex_pos):
+            qb = q[f.qi]
+            Mb = f.data.mass_block(self.space.rotation(qb[None, :nqb])[0], qb[nqb:])
             np.add.at(data, pos, Mb.ravel())
         return _make_csr(data, *self._M_pattern, self._M.shape)
 

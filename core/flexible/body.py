@@ -112,6 +112,7 @@ T. R. Kane, R. R. Ryan, A. K. Banerjee, J. Guidance 10(2):139–151, 1987.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
@@ -140,7 +141,10 @@ def _cross(a: Array, b: Array) -> Array:
 def _w_cross(w: Array, v: Array) -> Array:
     """ω × v with ω (n_rot,) and v (..., d): planar ``ω e_z × v``."""
     if v.shape[-1] == 2:
-        return w[0] * np.stack([-v[..., 1], v[..., 0]], -1)
+        out = np.empty_like(v, dtype=float)
+        out[..., 0] = -w[0] * v[..., 1]
+        out[..., 1] = w[0] * v[..., 0]
+        return out
     return np.cross(w, v)
 
 
@@ -268,15 +272,34 @@ class FlexibleBodyData:
         return fn(mesh, section, self.T @ np.asarray(qf, float), theory)
 
     # --- dynamics ---------------------------------------------------------------------------
-    def _D(self, qf: Array) -> Array:
+    @cached_property
+    def _D_template(self) -> tuple[Array, Array, Array]:
+        """:math:`D(0)` and the positions of the entries that hold the modal coordinates."""
         d, r, m = self.dim, self.n_rot, self.n_modes
         a = d + r
         D = np.zeros((a + m * r + m, a + m))
         D[:a, :a] = np.eye(a)
-        rows = a + np.arange(m * r)
-        D[rows, d + np.tile(np.arange(r), m)] = np.repeat(qf, r)
         D[a + m * r:, a:] = np.eye(m)
+        return D, a + np.arange(m * r), d + np.tile(np.arange(r), m)
+
+    def _D(self, qf: Array) -> Array:
+        D0, rows, cols = self._D_template
+        D = D0.copy()
+        D[rows, cols] = np.repeat(qf, self.n_rot)
         return D
+
+    def mass_block(self, A: Array, qf: Array) -> Array:
+        """The mass block of :meth:`mass_and_forces` alone (what the mass matrix needs, without the
+        forces)."""
+        if self.inertia == "undeformed":
+            Mb = self.undeformed_mass().copy()
+        else:
+            D = self._D(qf)
+            Mb = D.T @ (self.gram @ D)
+        d = self.dim
+        Mb[:d, :] = A @ Mb[:d, :]
+        Mb[:, :d] = Mb[:, :d] @ A.T
+        return 0.5 * (Mb + Mb.T)
 
     def mass_and_forces(self, A: Array, rdot: Array, w: Array, qf: Array, qfd: Array, g: Array):
         """Mass block and generalized forces in the model's velocity coordinates
@@ -289,7 +312,7 @@ class FlexibleBodyData:
         V = A.T @ rdot
         if self.inertia == "undeformed":
             return self._undeformed_mass_and_forces(A, V, w, qf, qfd, g)
-        c = np.concatenate([V, w, np.repeat(qf, r) * np.tile(w, m), qfd])
+        c = np.concatenate([V, w, (qf[:, None] * w[None, :]).ravel(), qfd])
         D = self._D(qf)
         G = self.gram
         y = G @ c
@@ -299,9 +322,7 @@ class FlexibleBodyData:
         yb = y[a:a + m * r].reshape(m, r)
         h = np.zeros(a + m)
         h[d:a] = qfd @ yb  # Ḋᵀ M c
-        cq = np.zeros_like(c)
-        cq[a:a + m * r] = np.repeat(qfd, r) * np.tile(w, m)
-        h += D.T @ (G @ cq)  # Dᵀ M Ḋ ν̂
+        h += MD[a:a + m * r].T @ (qfd[:, None] * w[None, :]).ravel()  # Dᵀ M Ḋ ν̂: Ḋ ν̂ fills the q_f ω rows
         h -= Mh[:, :d] @ _w_cross(w, V)  # M̂ (−ω̄ × V̄) from V̄̇ = Aᵀr̈ − ω̄ × V̄
         h[:d] += _w_cross(w, p[:d])
         if d == 3:
@@ -323,8 +344,13 @@ class FlexibleBodyData:
         return 0.5 * (Mb + Mb.T), rhs  # symmetric to the last bit (the products round differently)
 
     def undeformed_mass(self) -> Array:
-        """:math:`\\hat M_0 = D(0)^T \\mathcal M D(0)` in the body-axes velocities ``(V̄, ω̄, q̇_f)``."""
-        D0 = self._D(np.zeros(self.n_modes))
+        """:math:`\\hat M_0 = D(0)^T \\mathcal M D(0)` in the body-axes velocities ``(V̄, ω̄, q̇_f)``
+        (a copy of the cached matrix)."""
+        return self._undeformed_mass.copy()
+
+    @cached_property
+    def _undeformed_mass(self) -> Array:
+        D0 = self._D_template[0]
         return D0.T @ self.gram @ D0
 
     def _undeformed_mass_and_forces(self, A, V, w, qf, qfd, g):
@@ -332,7 +358,7 @@ class FlexibleBodyData:
         Kirchhoff's equations with the constant :math:`\\hat M_0` (module docstring)."""
         d, r = self.dim, self.n_rot
         a = d + r
-        Mh = self.undeformed_mass()
+        Mh = self._undeformed_mass
         p = Mh @ np.concatenate([V, w, qfd])
         h = -Mh[:, :d] @ _w_cross(w, V)
         h[:d] += _w_cross(w, p[:d])
@@ -651,10 +677,11 @@ class FlexibleNodes(UserConstraint):
         return vv[:sp_.n_v], vv[sp_.n_v:sp_.n_v * (k + 1)].reshape(k, sp_.n_v), vv[sp_.n_v * (k + 1):]
 
     def _frames(self, ref, nod):
+        """The frame's rotation matrix and the nodes' (these only in space: the planar rows use the
+        node angles directly)."""
         sp_ = self.space
         A = sp_.rotation(ref[None])[0]
-        AN = sp_.rotation(nod)
-        return A, AN
+        return A, (sp_.rotation(nod) if self.data.dim == 3 else None)
 
     def phi(self, t, q):
         d = self.data.dim

@@ -207,6 +207,9 @@ def cycloidal(change: float, duration: float, start: float = 0.0) -> TimeFunctio
         h = parse_quantity(change, "1", where="cycloidal change")
     T = parse_quantity(duration, "s", where="cycloidal duration")
     t0 = parse_quantity(start, "s", where="cycloidal start")
+    for name, value in (("change", h), ("duration", T), ("start", t0)):
+        if np.ndim(value) != 0:
+            raise InputError(f"cycloidal: {name} must be one number, got {value!r} (one law per driver)")
     if not T > 0.0:
         raise InputError(f"cycloidal: duration = {duration!r} must be a positive time")
     return TimeFunction(*(_Cycloidal(h, T, t0, k) for k in range(3)), f"cycloidal {h:g} in {T:g} s from {t0:g} s")

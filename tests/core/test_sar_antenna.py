@@ -48,7 +48,8 @@ def test_cycloidal_law_values_derivatives_and_peaks():
                                        (dict(change=1.0, duration="10 kg"), "duration"),
                                        (dict(change=1.0, duration="ten"), "duration"),
                                        (dict(change=np.nan, duration=1.0), "change"),
-                                       (dict(change="90 kg", duration=1.0), "change")])
+                                       (dict(change="90 kg", duration=1.0), "change"),
+                                       (dict(change=[1.0, 2.0], duration=1.0), "change must be one number")])
 def test_cycloidal_law_refuses_bad_input(kw, match):
     with pytest.raises(InputError, match=match):
         cycloidal(**kw)

@@ -345,6 +345,8 @@ def momenta(model: Model, q: np.ndarray, v: np.ndarray) -> np.ndarray:
     along x or y (``(1, 0, 0)``, ``(0, 1, 0)`` for a body's frame) or a unit rotation about the origin
     (``(−y, x, 1)``); modal coordinates do not move in either.  Without external forces and moments
     all three are conserved, whatever the joints, drivers and elastic forces inside the model.
+    Every extra coordinate is taken as internal like a modal one: for a model whose extra
+    coordinates are absolute positions (a series damper's node), the result is not its momentum.
     """
     if model.space.dim != 2:
         raise ValueError("momenta: planar models only")

@@ -71,7 +71,7 @@ import numpy as np
 from ..drivers import TimeFunction
 from ..model import Model, ModelBuilder
 
-__all__ = ["KANE_SPIN_UP", "SAR_ANTENNA", "SIMEON_ROD", "chord_deflection", "driven_cantilever",
+__all__ = ["KANE_SPIN_UP", "SAR_ANTENNA", "SIMEON_ROD", "cantilever_roots", "chord_deflection", "driven_cantilever",
            "hub_frame_deflection", "momenta", "panel_tip_deflection", "sar_antenna", "sar_antenna_section",
            "slider_crank_chain", "slider_crank_flexible", "spin_up_angle", "spin_up_beam", "spin_up_chain"]
 
@@ -373,7 +373,7 @@ def panel_tip_deflection(model: Model, q: np.ndarray, panel: str) -> np.ndarray:
     return -np.sin(th) * (tip[:, 0] - root[:, 0]) + np.cos(th) * (tip[:, 1] - root[:, 1])
 
 
-def _cantilever_roots(n: int) -> np.ndarray:
+def cantilever_roots(n: int) -> np.ndarray:
     """β_k L of the clamped–free Euler–Bernoulli beam: the roots of 1 + cos x cosh x = 0."""
     from scipy.optimize import brentq
 
@@ -413,7 +413,7 @@ def driven_cantilever(angle, t: np.ndarray, length: float, mass_per_length: floa
     if t.ndim != 1 or t.size < 2 or not np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0.0) or t[1] <= t[0]:
         raise ValueError("driven_cantilever: t must be at least two evenly spaced, increasing times")
     L, mu = float(length), float(mass_per_length)
-    beta = _cantilever_roots(n_modes) / L
+    beta = cantilever_roots(n_modes) / L
     sigma = (np.cosh(beta * L) + np.cos(beta * L)) / (np.sinh(beta * L) + np.sin(beta * L))
 
     def phi(k, x):

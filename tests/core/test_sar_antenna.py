@@ -76,6 +76,14 @@ def test_reference_quasi_static_tip_deflection_is_the_cantilever_closed_form():
     assert tip[k] == pytest.approx(static, rel=1e-4)
 
 
+def test_cantilever_roots_are_the_published_eigenvalues():
+    """β_k L of the clamped–free beam (Blevins 1979, table 8-1, as in test_flexible_beam.py)."""
+    from core.flexible.models import cantilever_roots
+
+    np.testing.assert_allclose(cantilever_roots(4), [1.875104068712, 4.694091132974, 7.854757438238, 10.995540734875],
+                               rtol=1e-11)
+
+
 def test_reference_refuses_uneven_times():
     with pytest.raises(ValueError, match="evenly spaced"):
         driven_cantilever(cycloidal(1.0, 1.0), np.array([0.0, 0.1, 0.3]), L, MU, EI)

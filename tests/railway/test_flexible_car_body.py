@@ -283,3 +283,21 @@ def test_careless_imports_are_refused_by_name(tmp_path, case, match):
         nodes.write_text("y,x,z\n" + "\n".join(",".join([r[1], r[0], r[2]]) for r in rows))
     with pytest.raises((DataFileError, InputError), match=match):
         VehicleDefinition.from_toml(_file(tmp_path, table))
+
+
+def test_the_guides_import_table_has_only_valid_keys():
+    """The guide's ```toml block for an imported FE model names files this test does not have; its
+    keys, units and node numbers pass the table's schema (a renamed key or a typo would not)."""
+    import re
+    import tomllib
+
+    from core.inputs import validate
+    from core.paths import repo_root
+    from railway.vehicles.vehicle_file import IMPORT_KEYS, FlexibleCarBody
+
+    page = (repo_root() / "docs" / "user-guide" / "railway-vehicles.md").read_text(encoding="utf-8")
+    block = re.search(r"```toml\n(\[car_body\.flexible\]\nmass_matrix.*?)```", page, re.S).group(1)
+    table = tomllib.loads(block)["car_body"]["flexible"]
+    fx = validate(FlexibleCarBody, table, source="guide", context={"accept": []})
+    assert set(table) - {"damping_ratio"} == set(IMPORT_KEYS)
+    assert fx.mass_unit == "t" and fx.length_unit == "mm" and fx.bogie_nodes == [35, 205] and fx.damping_ratio == 0.02

@@ -42,7 +42,8 @@ class TimeFunction:
         Used in error messages.
     spec : tuple, optional
         ``(kind, *parameters)`` of a closed form or table (``"const"``, ``"poly"``,
-        ``"harmonic"``, ``"spline"``) that the compiled path can evaluate; None for callables.
+        ``"harmonic"``, ``"spline"``, ``"cycloidal"``) that the compiled path can evaluate; None for
+        callables.
     """
 
     def __init__(self, f: Callable[[float], float], fd: Callable[[float], float], fdd: Callable[[float], float],
@@ -194,7 +195,7 @@ def cycloidal(change: float, duration: float, start: float = 0.0) -> TimeFunctio
     ``f = 0`` before and ``f = h`` after.  ``change`` is in the driven coordinate's SI unit (rad or
     m), or a string with its unit (``"90 deg"``); ``duration`` and ``start`` in s or with a unit.
     Velocity and acceleration are continuous (zero at both ends); the jerk jumps at both ends.  Peak velocity ``2h/T``, peak acceleration ``2πh/T²``.
-    Evaluated in Python only: a driver using it keeps a model on the numpy right-hand side.
+    The compiled path evaluates the same formulas (:mod:`core.compiled.timefunctions`).
     """
     from .inputs import UnitError, parse_quantity
 
@@ -212,7 +213,8 @@ def cycloidal(change: float, duration: float, start: float = 0.0) -> TimeFunctio
             raise InputError(f"cycloidal: {name} must be one number, got {value!r} (one law per driver)")
     if not T > 0.0:
         raise InputError(f"cycloidal: duration = {duration!r} must be a positive time")
-    return TimeFunction(*(_Cycloidal(h, T, t0, k) for k in range(3)), f"cycloidal {h:g} in {T:g} s from {t0:g} s")
+    return TimeFunction(*(_Cycloidal(h, T, t0, k) for k in range(3)), f"cycloidal {h:g} in {T:g} s from {t0:g} s",
+                        spec=("cycloidal", float(h), float(T), float(t0), False))
 
 
 def tabulated(times, values, label: str = "table", bc_type: str = "not-a-knot",

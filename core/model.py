@@ -271,8 +271,9 @@ class ModelBuilder:
         inertia : str
             ``"full"`` (default): the kinetic energy of the deformed body, exact for the floating
             frame; ``"undeformed"``: that of the undeformed body, a rigid body plus modal oscillators
-            coupled through the node frames (slowly rotating bodies such as a railway car body; the
-            form the compiled integrators take, :mod:`core.flexible.compiled`).
+            coupled through the node frames (slowly rotating bodies such as a railway car body; with
+            mean-axis modes the cheapest form on the compiled path).  Both run on the numpy and the
+            compiled integrators (:mod:`core.flexible.compiled`).
 
         Returns
         -------
@@ -1149,6 +1150,8 @@ class Model(ConstrainedSystem):
         point P: ``M_P = M_cm − (r_P − r_cm) × F``.
         """
         J = self.Phi_q(t, q)
+        if sp.issparse(J):  # dense rows: per-joint sparse slicing cost ~0.1 ms a joint
+            J = J.toarray()
         groups = self.reaction_groups()
         bs = self.body_states(q, None)
         d, nvb = self.space.dim, self.space.n_v

@@ -27,7 +27,6 @@ import time as _time
 
 import numpy as np
 
-from .dynamics import accelerations
 from .errors import RUN_FAILURES, InputError
 from .integrators.base import (
     FINISHED_STATUSES,
@@ -276,7 +275,7 @@ def simulate(system: ConstrainedSystem, t_span, method: str | type[Integrator] =
             lam = lams[i]
             if lam is None or not (integ.provides_multipliers and len(lam) == system.n_c):
                 try:
-                    _, lam = accelerations(system, t, q, v)
+                    lam = integ.multipliers(t, q, v)
                 except RUN_FAILURES:
                     lam = np.full(system.n_c, np.nan)
             L[i] = lam

@@ -6,6 +6,8 @@ the flat arrays of :func:`core.compiled.layout.compile_model` and the kinds' ker
 * :func:`body_states` — positions, rotation matrices and velocities of all bodies (3-D form);
 * :func:`forces` — gravity, gyroscopic moments ``−ω̄ × J ω̄`` and every force kind's kernel;
 * :func:`constraints` — every constraint kind's rows of ``Φ``, ``Φ_q`` (slot blocks), ``ν``, ``γ``;
+* :func:`mass_update` — the mass matrices of the mass groups (bodies whose inertia follows their
+  deformation) and their inverses;
 * :func:`factor` / :func:`saddle_solve` — ``[[M, Φ_qᵀ], [Φ_q, 0]] [x; μ] = [f; g]`` by the Schur
   complement of the regular rows with the border of massless coordinates
   (:mod:`core.compiled.layout`);
@@ -35,18 +37,19 @@ parameter rates).
 from __future__ import annotations
 
 # numba bakes module constants such as protocol.MAX_SLOTS into its cached machine code and keys the
-# cache on this file only: this file changed with MAX_SLOTS (3 -> 8, flexible bodies' node frames),
-# so that no stale kernel of the old width runs (docs/architecture.md, numba's on-disk cache)
+# cache on this file only: this file changed with MAX_SLOTS (3 -> 8, flexible bodies' node frames)
+# and with the mass groups (the saddle solve's signature), so that no stale kernel runs
+# (docs/architecture.md, numba's on-disk cache)
 
 import numba
 import numpy as np
 from numba.core import types
 from numba.experimental import structref
 
-from .protocol import MAX_SLOTS, NONFINITE, OK, SINGULAR, WANT_GAMMA, WANT_NU, WANT_PHI
+from .protocol import MASS_NOT_PD, MAX_SLOTS, NONFINITE, OK, SINGULAR, WANT_GAMMA, WANT_NU, WANT_PHI
 
 __all__ = ["Workspace", "make_workspace", "body_states", "forces", "constraints", "factor", "saddle_solve",
-           "accelerations", "project", "accept", "force_jacobian", "qdot", "retract", "normalize", "PIVOT_RTOL",
+           "accelerations", "project", "accept", "force_jacobian", "qdot", "retract", "normalize", "mass_update", "PIVOT_RTOL",
            "FAMILY_FORCE", "FAMILY_CONSTRAINT"]
 
 _jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
@@ -63,6 +66,7 @@ WORKSPACE_FIELDS = (
     "S", "L", "rhs",               # Schur complement, envelope factor, right-hand side (m_R)
     "C", "W", "T", "piv", "z",     # border: C (m_R, n_z), W = S⁻¹C, T (n_z, n_z) LU, pivots, z (n_z)
     "Q", "g", "mu", "tmp_v", "tmp_v2", "err",
+    "Mg", "Mgi", "gx", "gy",       # mass groups: matrices, inverses (n_g, w, w); work vectors (w)
 )
 
 
@@ -114,6 +118,9 @@ def make_workspace(cm) -> Workspace:
         piv=np.zeros(max(nz, 1), np.int64), z=np.zeros(max(nz, 1)),
         Q=np.zeros(n_v), g=np.zeros(m_all), mu=np.zeros(m_all), tmp_v=np.zeros(n_v), tmp_v2=np.zeros(n_v),
         err=np.zeros(3, np.int64),
+        Mg=np.zeros((max(cm.n_grp, 1), cm.group_width, cm.group_width)),
+        Mgi=np.zeros((max(cm.n_grp, 1), cm.group_width, cm.group_width)),
+        gx=np.zeros(cm.group_width), gy=np.zeros(cm.group_width),
     )
     return Workspace(*(fields[f] for f in WORKSPACE_FIELDS))
 
@@ -307,7 +314,84 @@ def constraints(cd, ws, t, q, v, flags):
             err[0] = k
             err[2] = 2
             return st
+    pad = cd.pad_slots
+    for p in range(pad.shape[0]):  # slots a row holds for a mass group it touches in part (layout)
+        a, sl = pad[p, 0], pad[p, 1]
+        for c in range(6):
+            G[a, sl, c] = 0.0
     return OK
+
+
+@_jit
+def mass_update(cd, ws, t, q, v):
+    r"""The mass matrices of the mass groups at ``q`` and their inverses (after :func:`body_states`).
+
+    A group's kernel writes ``M_g(q)`` (symmetric positive definite); its inverse is formed from
+    the Cholesky factor, :math:`M_g^{-1} = L^{-T} L^{-1}` (Golub & Van Loan 2013, Alg. 4.2.1).
+    Without groups this returns at once.  Status :data:`~core.compiled.protocol.MASS_NOT_PD` with
+    ``ws.err = (group, 0, 3)`` for a matrix that is not positive definite.
+    """
+    n_g = cd.n_grp
+    if n_g == 0:
+        return OK
+    err = ws.err
+    st = cd.mass_k[0](t, q, v, ws.r, ws.A, ws.rd, ws.w, cd.lay, cd.mass_fd, cd.mass_ix, ws.Mg, err)
+    if st != OK:
+        err[2] = 3
+        return st
+    Mg, Mi, grp_w = ws.Mg, ws.Mgi, cd.grp_w
+    for g in range(n_g):
+        if not _spd_inverse(Mg, Mi, g, grp_w[g]):
+            err[0] = g
+            err[2] = 3
+            return MASS_NOT_PD
+    return OK
+
+
+@_inline
+def _spd_inverse(Mg, Mi, g, n):
+    """``Mi[g] = Mg[g]⁻¹`` of a symmetric positive definite ``n × n`` block (Cholesky: the factor in
+    the lower triangle of ``Mi[g]``, then ``L⁻¹`` and ``L⁻ᵀL⁻¹``); False if not positive definite."""
+    for i in range(n):
+        for j in range(i + 1):
+            s = Mg[g, i, j]
+            for k in range(j):
+                s -= Mi[g, i, k] * Mi[g, j, k]
+            if i == j:
+                if not s > 0.0:
+                    return False
+                Mi[g, i, i] = np.sqrt(s)
+            else:
+                Mi[g, i, j] = s / Mi[g, j, j]
+    # L⁻¹ in place (lower triangle)
+    for i in range(n):
+        Mi[g, i, i] = 1.0 / Mi[g, i, i]
+        for j in range(i):
+            s = 0.0
+            for k in range(j, i):
+                s += Mi[g, i, k] * Mi[g, k, j]
+            Mi[g, i, j] = -s * Mi[g, i, i]
+    # L⁻ᵀ L⁻¹, symmetric: the upper triangle from the lower one
+    for i in range(n):
+        for j in range(i, n):
+            s = 0.0
+            for k in range(j, n):
+                s += Mi[g, k, i] * Mi[g, k, j]
+            Mi[g, j, i] = s
+    for i in range(n):
+        for j in range(i + 1, n):
+            Mi[g, i, j] = Mi[g, j, i]
+    return True
+
+
+@_inline
+def _group_times(Mi, grp_v, g, n, src, dst):
+    """``dst[v_g] = M_g⁻¹ src[v_g]`` over the velocity indices ``v_g`` of group ``g``."""
+    for i in range(n):
+        acc = 0.0
+        for j in range(n):
+            acc += Mi[g, i, j] * src[grp_v[g, j]]
+        dst[grp_v[g, i]] = acc
 
 
 @_jit
@@ -410,21 +494,26 @@ def _block_sub(x, o, X, a, sl, mk, wdt):
 @_jit
 def factor(cd, ws):
     """``X = M⁻¹Φ_qᵀ`` blocks, ``S`` of the regular rows with its envelope Cholesky factor, and the
-    border ``C``, ``W = S⁻¹C``, ``T`` with its LU (:mod:`core.compiled.layout`); status code."""
+    border ``C``, ``W = S⁻¹C``, ``T`` with its LU (:mod:`core.compiled.layout`); status code.
+    The inverse mass matrices of the mass groups are those of the last :func:`mass_update`."""
     return _factor(cd.reg, cd.env_first, cd.r_blk, cd.blk_x, cd.blk_w, cd.minv, cd.pat, cd.ext, cd.rs_cnt, cd.rs,
-                   cd.n_x, cd.xm, cd.hpat, cd.epat, ws.S, ws.L, ws.G, ws.X, ws.C, ws.W, ws.T, ws.piv)
+                   cd.n_x, cd.xm, cd.hpat, cd.epat, ws.S, ws.L, ws.G, ws.X, ws.C, ws.W, ws.T, ws.piv,
+                   cd.blk_g, cd.blk_go, cd.grp_w, cd.rg_cnt, cd.rg, ws.Mgi, ws.gx, ws.gy)
 
 
 @_inline
 def _factor(reg, first, r_blk, blk_x, blk_w, minv, pat, ext, rs_cnt, rs, nx, xm, hpat, epat, S, L, G, X, C, W, T,
-            piv):
+            piv, blk_g, blk_go, grp_w, rg_cnt, rg, Mgi, gx, gy):
     """:func:`factor` on arrays (inlined where the caller has loaded them once)."""
     m = reg.shape[0]
     ne = ext.shape[0]
     for k in range(m + ne):
         a = reg[k] if k < m else ext[k - m]
         for u in range(rs_cnt[a]):
-            _minv_times_row(minv, rs[a, u, 1], rs[a, u, 3], G, X, a, rs[a, u, 0])
+            if blk_g[rs[a, u, 1]] < 0:
+                _minv_times_row(minv, rs[a, u, 1], rs[a, u, 3], G, X, a, rs[a, u, 0])
+        for i in range(rg_cnt[a]):  # X on a mass group: gather the row's entries, M_g⁻¹, scatter
+            _group_row(Mgi, rg[a, i], grp_w[rg[a, i]], blk_g, blk_go, rs_cnt, rs, G, X, a, gx, gy)
     for i in range(m):
         for j in range(first[i], i + 1):
             S[i, j] = 0.0
@@ -487,6 +576,30 @@ def _factor(reg, first, r_blk, blk_x, blk_w, minv, pat, ext, rs_cnt, rs, nx, xm,
         a, sa, b, sb, wdt = epat[p, 0], epat[p, 1], epat[p, 2], epat[p, 3], epat[p, 6]
         T[nx + epat[p, 4], nx + epat[p, 5]] -= _block_dot(G, a, sa, X, b, sb, wdt)
     return _lu_factor(T, nz, piv)
+
+
+@_inline
+def _group_row(Mgi, g, n, blk_g, blk_go, rs_cnt, rs, G, X, a, gx, gy):
+    """``X[a] = M_g⁻¹ G[a]`` on the blocks of group ``g`` (the row holds a slot on each of them)."""
+    for c in range(n):
+        gx[c] = 0.0
+    for u in range(rs_cnt[a]):
+        b = rs[a, u, 1]
+        if blk_g[b] == g:
+            o, sl = blk_go[b], rs[a, u, 0]
+            for c in range(rs[a, u, 3]):
+                gx[o + c] = G[a, sl, c]
+    for i in range(n):
+        acc = 0.0
+        for j in range(n):
+            acc += Mgi[g, i, j] * gx[j]
+        gy[i] = acc
+    for u in range(rs_cnt[a]):
+        b = rs[a, u, 1]
+        if blk_g[b] == g:
+            o, sl = blk_go[b], rs[a, u, 0]
+            for c in range(rs[a, u, 3]):
+                X[a, sl, c] = gy[o + c]
 
 
 @_inline
@@ -558,18 +671,21 @@ def saddle_solve(cd, ws, f, g, x, mu):
     ``g`` and ``mu`` are indexed by model rows (``mu`` is written for the active rows).
     """
     _saddle(cd.reg, cd.env_first, cd.blk_v0, cd.blk_w, cd.blk_x, cd.minv, cd.ext, cd.rs_cnt, cd.rs, cd.mass_blocks,
-            cd.n_x, ws.G, ws.X, ws.rhs, ws.z, ws.L, ws.C, ws.W, ws.T, ws.piv, f, g, x, mu)
+            cd.n_x, ws.G, ws.X, ws.rhs, ws.z, ws.L, ws.C, ws.W, ws.T, ws.piv, f, g, x, mu, cd.n_grp, cd.grp_v,
+            cd.grp_w, ws.Mgi)
 
 
 @_inline
 def _saddle(reg, first, blk_v0, blk_w, blk_x, minv, ext, rs_cnt, rs, mass_blocks, nx, G, X, rhs, z, L, C, W, T, piv,
-            f, g, x, mu):
+            f, g, x, mu, n_grp, grp_v, grp_w, Mgi):
     """:func:`saddle_solve` on arrays (inlined where the caller has loaded them once)."""
     # x_B0 = M_B⁻¹ f_B
     for u in range(mass_blocks.shape[0]):
         b = mass_blocks[u]
         o = blk_v0[b]
         _minv_times(minv, b, blk_w[b], f, o, x, o)
+    for gi in range(n_grp):
+        _group_times(Mgi, grp_v, gi, grp_w[gi], f, x)
     m = reg.shape[0]
     for k in range(m):
         a = reg[k]
@@ -643,6 +759,9 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
     st = forces(cd, states, ws, t, q, v, Q)
     if st != OK:
         return st
+    st = mass_update(cd, ws, t, q, v)
+    if st != OK:
+        return st
     m = act.shape[0]
     if m == 0:
         mass_blocks = cd.mass_blocks
@@ -650,6 +769,11 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
             b = mass_blocks[u]
             o = blk_v0[b]
             _minv_times(minv, b, blk_w[b], Q, o, vdot, o)
+        for gi in range(cd.n_grp):
+            _group_times(ws.Mgi, cd.grp_v, gi, cd.grp_w[gi], Q, vdot)
+        for i in range(vdot.shape[0]):
+            if not np.isfinite(vdot[i]):
+                return NONFINITE
         return OK
     baum = alpha != 0.0 or beta != 0.0
     flags = WANT_GAMMA
@@ -661,7 +785,7 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
     reg, first, blk_x, ext, rs_cnt, rs, nx = cd.reg, cd.env_first, cd.blk_x, cd.ext, cd.rs_cnt, cd.rs, cd.n_x
     G, X, S, L, C, W, T, piv = ws.G, ws.X, ws.S, ws.L, ws.C, ws.W, ws.T, ws.piv
     st = _factor(reg, first, r_blk, blk_x, blk_w, minv, cd.pat, ext, rs_cnt, rs, nx, cd.xm, cd.hpat, cd.epat,
-                 S, L, G, X, C, W, T, piv)
+                 S, L, G, X, C, W, T, piv, cd.blk_g, cd.blk_go, cd.grp_w, cd.rg_cnt, cd.rg, ws.Mgi, ws.gx, ws.gy)
     if st != OK:
         return st
     g, gam, nu, phi, mu = ws.g, ws.gam, ws.nu, ws.phi, ws.mu
@@ -672,7 +796,7 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
             ga -= 2.0 * alpha * (_row_dot(r_blk, blk_v0, blk_w, G, a, v) - nu[a]) + beta * beta * phi[a]
         g[a] = ga
     _saddle(reg, first, blk_v0, blk_w, blk_x, minv, ext, rs_cnt, rs, cd.mass_blocks, nx, G, X, ws.rhs, ws.z, L, C, W,
-            T, piv, Q, g, vdot, mu)
+            T, piv, Q, g, vdot, mu, cd.n_grp, cd.grp_v, cd.grp_w, ws.Mgi)
     for k in range(m):
         lam[k] = mu[act[k]]
     for i in range(vdot.shape[0]):
@@ -713,7 +837,7 @@ def project(cd, ws, t, q, v, tol, max_iter, counters):
     err = _max_abs_phi(act, phi)
     n_iter = 0
     if err > tol:
-        if factor(cd, ws) != OK:
+        if mass_update(cd, ws, t, q, v) != OK or factor(cd, ws) != OK:
             return -1
         counters[3] += 1
         prev = np.inf
@@ -740,7 +864,7 @@ def project(cd, ws, t, q, v, tol, max_iter, counters):
     body_states(lay, q, v, ws)
     if constraints(cd, ws, t, q, v, WANT_NU) != OK:
         return -1
-    if factor(cd, ws) != OK:
+    if mass_update(cd, ws, t, q, v) != OK or factor(cd, ws) != OK:
         return -1
     counters[3] += 1
     for k in range(m):

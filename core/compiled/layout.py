@@ -14,9 +14,22 @@ coordinates (width 1).  Blocks with a positive definite mass block ``M_b`` are e
 bodies with a singular mass block (a slider or a point mass without rotational inertia, whose
 rotation the joints fix) — form the *border* X with their (singular) mass matrix ``M_XX``.
 The regular rows R are an independent set of the rows touching blocks with ``M_b > 0`` (all of them
-without a border; chosen by pivoted QR at the initial configuration otherwise), so that
-``S = G_{RB} M_B^{-1} G_{RB}^T`` is positive definite; the other rows E (rows on border
-coordinates only, and the dependent remainder) join the border.  With ``x = (x_B, x_X)``,
+without a border), so that ``S = G_{RB} M_B^{-1} G_{RB}^T`` is positive definite; the other rows E
+(rows on border coordinates only, and the remainder) join the border.  With a border the set must
+stay independent as the model moves, not only at the start: on a turning flexible body the hub
+pin's rows and the tip node frame's rows, restricted to the body, are independent at most angles
+and dependent at 0 and π/2, and a set chosen at the start then makes ``S`` singular half a turn
+later.  So rows are taken greedily at the initial configuration in an order that keeps the set
+independent: rows touching no border coordinate first (independent at every configuration, as the
+model's rows are), then the other rows touching the border; the rows of kinds that fix massless
+bodies (``CompiledConstraints.border``: a flexible body's node frames) go to E at once.
+
+*Mass groups* (:class:`core.compiled.protocol.CompiledMass`: a flexible body with the deformed
+body's inertia) are blocks with mass whose joint mass matrix depends on the configuration: their
+kernel writes it at every evaluation, :func:`core.compiled.dynamics.mass_update` inverts it by its
+Cholesky factor, and ``M_B⁻¹`` applies it to the group's coordinates together; every row touching a
+group holds a slot on each of its blocks (added here, their Jacobian entries zero) so that
+``X = M_B⁻¹G_RBᵀ`` and the Schur pattern are complete.  With ``x = (x_B, x_X)``,
 ``μ = (μ_R, μ_E)`` and ``z = (x_X, μ_E)`` the system ``[[M, Gᵀ], [G, 0]] [x; μ] = [f; g]``
 is solved by block elimination of ``x_B`` and ``μ_R`` (Benzi, Golub & Liesen 2005, Sec. 5):
 
@@ -58,14 +71,17 @@ from .protocol import (
     CONSTRAINT_SIGNATURE,
     FORCE_JACOBIAN_SIGNATURE,
     FORCE_SIGNATURE,
+    MASS_SIGNATURE,
     MAX_SLOTS,
     OK,
     CompiledConstraints,
     CompiledForces,
+    CompiledMass,
     accept_kernel,
     constraint_kernel,
     force_jacobian_kernel,
     force_kernel,
+    mass_kernel,
     resolve_kernel,
 )
 
@@ -98,6 +114,14 @@ MODEL_FIELDS = (
     "xm",         # float (n_x, n_x): their mass matrix M_XX (block diagonal, singular)
     "hpat",       # int64 (n_h, 7): (a, slot_a, e_row, slot_e, k, e, width): H[k, e] += G[a,sa]·X[e_row,se]
     "epat",       # int64 (n_ee, 7): (e1_row, s1, e2_row, s2, e1, e2, width): S_EE[e1, e2] += G·X
+    "n_grp",      # int: mass groups (configuration-dependent mass matrices, protocol "Mass groups")
+    "blk_g",      # int64 (n_blk,): group of each block, −1 for blocks with a constant inverse mass
+    "blk_go",     # int64 (n_blk,): first position of the block in its group's coordinates
+    "grp_v",      # int64 (n_g, w_max): velocity indices of each group
+    "grp_w",      # int64 (n_g,): number of coordinates of each group
+    "rg_cnt",     # int64 (m_all,): groups a row touches
+    "rg",         # int64 (m_all, MAX_SLOTS): those groups
+    "pad_slots",  # int64 (n_pad, 2): (row, slot) added for groups: their Jacobian entries are zero
 )
 #: ... and the kinds' kernels (tuples of function pointers padded to KIND_CAPACITY with no-ops)
 #: with their data stored flat: kind ``k`` reads ``fd[fo[k]:fo[k+1]].reshape(n[k], fw[k])`` and
@@ -107,6 +131,7 @@ KERNEL_FIELDS = (
     "n_con", "con", "con_fd", "con_fo", "con_n", "con_fw", "con_ix", "con_io", "con_iw", "con_row0",
     "n_frc", "frc", "frc_fd", "frc_fo", "frc_n", "frc_fw", "frc_ix", "frc_io", "frc_iw",
     "frc_jac", "frc_has_jac", "frc_acc", "frc_stateful", "st_off", "st_n", "st_w",
+    "mass_k", "mass_fd", "mass_ix",  # the mass kernel of the groups (a 1-tuple; a no-op without groups) and its data
 )
 
 
@@ -147,7 +172,8 @@ class Layout:
     Attributes
     ----------
     n_bodies, dim, n_q_body, n_v_body, n_q, n_v : int
-    extra_names : list of str
+    extra_names, body_names : list of str
+    gravity : ndarray (dim,)
     """
 
     def __init__(self, model):
@@ -159,6 +185,7 @@ class Layout:
         self.n_q, self.n_v = model.n_q, model.n_v
         self.extra_names = list(model.extra_names)
         self.body_names = list(model.body_names)
+        self.gravity = np.asarray(model.gravity, float).copy()
 
     def model_body_index(self, name: str) -> int:
         """Index of a body of the model (the ground: ``n_bodies``)."""
@@ -207,6 +234,11 @@ def _no_accept(t, q, v, r, A, rd, w, lay, fd, ix, state, err):
     return OK
 
 
+@mass_kernel
+def _no_mass(t, q, v, r, A, rd, w, lay, fd, ix, Mg, err):
+    return OK
+
+
 class CompiledModel:
     """A model packed for the compiled path (cached per model; see :func:`compile_model`).
 
@@ -224,12 +256,16 @@ class CompiledModel:
         Some force kind keeps a search state (copied per run by :meth:`initial_states`).
     """
 
-    def __init__(self, model, fields: dict, constraint_kinds, force_kinds, states: np.ndarray):
+    def __init__(self, model, fields: dict, constraint_kinds, force_kinds, states: np.ndarray,
+                 mass_record: CompiledMass | None = None):
         self.name = model.name
         self.fields = fields
         self.data = CompiledData(*(fields[f] for f in MODEL_FIELDS + KERNEL_FIELDS))
         self.constraint_kinds = constraint_kinds
         self.force_kinds = force_kinds
+        self.mass_record = mass_record
+        self.n_grp = int(fields["n_grp"])
+        self.group_width = int(fields["grp_v"].shape[1])
         self._states = states
         self.n_x = int(fields["n_x"])
         self.n_e = len(fields["ext"])
@@ -285,7 +321,13 @@ class CompiledModel:
         return str(cb(np.asarray(states[a:b]).reshape(int(self._st_n[kind]), int(self._st_w[kind]))))
 
     def element_name(self, family: str, kind: int, element: int) -> str:
-        """Name of the element a kernel reported in ``err`` (family 'force' or 'constraint')."""
+        """Name of the element a kernel reported in ``err`` (family 'force', 'constraint' or 'mass';
+        for a mass group ``kind`` is the group)."""
+        if family == "mass":
+            rec = self.mass_record
+            if rec is not None and 0 <= kind < len(rec.names):
+                return f"{rec.what} {rec.names[kind]!r}"
+            return "a mass group"
         recs = self.force_kinds if family == "force" else self.constraint_kinds
         if 0 <= kind < len(recs):
             rec = recs[kind]
@@ -338,8 +380,9 @@ def _compile(model) -> CompiledModel:
     sp_ = model.space
     nb, dim, nvb = model.n_bodies, sp_.dim, sp_.n_v
     ne = len(model.extra_names)
-    # --- flexible bodies: a rigid block plus modal oscillators (core.flexible.compiled) ----------------
-    flex_blocks, flex_extra_mass, flex_rows = {}, {}, []
+    # --- flexible bodies (core.flexible.compiled): a rigid block plus modal oscillators, or a mass
+    # group whose mass matrix follows the deformation (its kernels recompute it at every evaluation) --
+    flex_blocks, flex_extra_mass, flex_rows, group_rows = {}, {}, [], []
     for f in getattr(model, "flexible", ()):
         from ..flexible.compiled import compiled_flexible_body
 
@@ -348,10 +391,21 @@ def _compile(model) -> CompiledModel:
             fb = compiled_flexible_body(f.data, layout, nvb, names)
         except NotCompilable as exc:
             raise NotCompilable(f"model {model.name!r}: {exc}") from None
+        if fb["form"] == "group":
+            fb["v_index"] = np.asarray(f.vi, np.int64)
+            group_rows.append(fb)
+            continue
         flex_blocks[f.body] = fb
         for c, mu in zip(names, fb["modal_mass"]):
             flex_extra_mass[model.extra_names.index(c)] = float(mu)
         flex_rows.append(fb)
+    mass_rec = None
+    if group_rows:
+        from ..flexible.compiled import inertia_records
+
+        mass_rec, inertia_forces = inertia_records(group_rows)
+    n_blk = nb + 1 + ne
+    blk_g, blk_go, groups, group_blocks = _mass_groups(model, mass_rec, nb, nvb, ne)
     # --- constraint kinds (model row order: primitive kinds, then user constraints) ------------------
     ckinds: list[CompiledConstraints] = []
     row = 0
@@ -376,8 +430,8 @@ def _compile(model) -> CompiledModel:
     r_blk = np.full((m_all, MAX_SLOTS), -1, np.int64)
     for rec in ckinds:
         r_blk[rec._row0:rec._row0 + rec.rows] = rec.slots
+    rg_cnt, rg, pad_slots = _group_slots(model, ckinds, r_blk, blk_g, group_blocks, mass_rec)
     # --- blocks and masses ---------------------------------------------------------------------------
-    n_blk = nb + 1 + ne
     blk_v0 = np.zeros(n_blk, np.int64)
     blk_w = np.zeros(n_blk, np.int64)
     blk_x = np.full(n_blk, -1, np.int64)
@@ -386,12 +440,14 @@ def _compile(model) -> CompiledModel:
     border_mass = []  # mass blocks of the border coordinates (singular or zero)
     nx = 0
     for k, bd in enumerate(model.bodies):
+        blk_v0[k], blk_w[k] = k * nvb, nvb
+        if blk_g[k] >= 0:  # a mass group's block: inverted with its group at every evaluation
+            continue
         blk = Mcsr[k * nvb:(k + 1) * nvb, k * nvb:(k + 1) * nvb].toarray()
         if k in flex_blocks:
             blk = flex_blocks[k]["mass_block"]
         if not np.all(np.isfinite(blk)):
             raise NotCompilable(f"model {model.name!r}: body {bd.name!r} has a non-finite mass matrix")
-        blk_v0[k], blk_w[k] = k * nvb, nvb
         if np.all(np.linalg.eigvalsh(0.5 * (blk + blk.T)) > 1e-14 * max(1.0, float(np.max(np.abs(blk))))):
             minv[k, :nvb, :nvb] = np.linalg.inv(blk)
         else:  # a singular mass block (zero inertia): its coordinates join the border
@@ -402,6 +458,8 @@ def _compile(model) -> CompiledModel:
     for k in range(ne):
         b = nb + 1 + k
         blk_v0[b], blk_w[b] = nb * nvb + k, 1
+        if blk_g[b] >= 0:
+            continue
         mass = flex_extra_mass.get(k, float(Mcsr[nb * nvb + k, nb * nvb + k]))
         if mass > 0:
             minv[b, 0, 0] = 1.0 / mass
@@ -428,20 +486,8 @@ def _compile(model) -> CompiledModel:
         else:
             raise NotCompilable(f"model {model.name!r}: constraint row {int(a)} touches no coordinate")
     if nx and reg_rows:
-        # with border coordinates, more rows may touch the blocks with mass than those blocks have
-        # freedoms: keep an independent set (pivoted QR of their rows restricted to the blocks with
-        # mass, at the initial configuration) as the regular rows and move the rest to E
-        J = model._Phi_q_all(0.0, model.q0).toarray()
-        cols = np.concatenate([np.arange(blk_v0[b], blk_v0[b] + blk_w[b]) for b in np.flatnonzero(massive)])
-        JB = J[np.ix_(reg_rows, cols)]
-        import scipy.linalg as sla
-
-        Rm, piv = sla.qr(JB.T, mode="r", pivoting=True)
-        diag = np.abs(np.diag(Rm)) if Rm.size else np.zeros(0)
-        rank = int(np.sum(diag > 1e-9 * max(1.0, diag[0] if len(diag) else 0.0)))
-        keep_rows = sorted(int(reg_rows[i]) for i in piv[:rank])
-        ext_rows = sorted(ext_rows + [int(reg_rows[i]) for i in piv[rank:]])
-        reg_rows = keep_rows
+        reg_rows, ext_rows = _independent_rows(model, ckinds, reg_rows, ext_rows, r_blk, blk_x, blk_v0, blk_w,
+                                               massive)
     touching: dict[int, list[tuple[int, int]]] = {}
     for ka, a in enumerate(reg_rows):
         for slot in range(MAX_SLOTS):
@@ -489,7 +535,13 @@ def _compile(model) -> CompiledModel:
             if b >= 0 and massive[b]:
                 rs[a, rs_cnt[a]] = (slot, b, blk_v0[b], blk_w[b])
                 rs_cnt[a] += 1
-    mass_blocks = np.flatnonzero(massive).astype(np.int64)
+    mass_blocks = np.flatnonzero(massive & (blk_g < 0)).astype(np.int64)  # blocks with a constant inverse
+    wg = max([len(g) for g in groups], default=1)
+    grp_v = np.zeros((max(len(groups), 1), wg), np.int64)
+    grp_w = np.zeros(max(len(groups), 1), np.int64)
+    for g, vi in enumerate(groups):
+        grp_v[g, :len(vi)] = vi
+        grp_w[g] = len(vi)
     # --- forces ----------------------------------------------------------------------------------------
     fkinds: list[CompiledForces] = []
     for fk in model.force_kinds:
@@ -501,7 +553,10 @@ def _compile(model) -> CompiledModel:
     if flex_rows:
         from ..flexible.compiled import modal_force_record
 
-        fkinds.append(modal_force_record(flex_rows, [f.data.name for f in model.flexible]))
+        fkinds.append(modal_force_record(flex_rows, [f.data.name for f in model.flexible
+                                                      if f.body in flex_blocks]))
+    if mass_rec is not None:
+        fkinds.append(inertia_forces)
     if len(ckinds) > KIND_CAPACITY or len(fkinds) > KIND_CAPACITY:
         raise NotCompilable(f"model {model.name!r} has {len(ckinds)} constraint and {len(fkinds)} force kinds; "
                             f"the compiled path takes at most {KIND_CAPACITY} of each")
@@ -517,10 +572,109 @@ def _compile(model) -> CompiledModel:
     fields = dict(lay=lay, blk_v0=blk_v0, blk_w=blk_w, blk_x=blk_x, minv=minv, Qg=Qg, Jt=Jt, r_blk=r_blk,
                   act=np.asarray(act, np.int64), reg=np.ascontiguousarray(reg_sorted), ext=ext_arr,
                   pat=np.ascontiguousarray(pat), env_first=env_first, rs_cnt=rs_cnt, rs=rs, mass_blocks=mass_blocks,
-                  n_x=np.int64(nx), xm=xm, hpat=np.ascontiguousarray(hpat), epat=np.ascontiguousarray(epat))
-    kernel_fields, states = _kernel_tuples(ckinds, fkinds)
+                  n_x=np.int64(nx), xm=xm, hpat=np.ascontiguousarray(hpat), epat=np.ascontiguousarray(epat),
+                  n_grp=np.int64(len(groups)), blk_g=blk_g, blk_go=blk_go, grp_v=grp_v, grp_w=grp_w, rg_cnt=rg_cnt,
+                  rg=rg, pad_slots=pad_slots)
+    kernel_fields, states = _kernel_tuples(ckinds, fkinds, mass_rec)
     fields.update(kernel_fields)
-    return CompiledModel(model, fields, ckinds, fkinds, states)
+    return CompiledModel(model, fields, ckinds, fkinds, states, mass_rec)
+
+
+def _independent_rows(model, ckinds, reg_rows, ext_rows, r_blk, blk_x, blk_v0, blk_w, massive):
+    """With border coordinates, more rows may touch the blocks with mass than those blocks have
+    freedoms: keep an independent set as the regular rows and move the rest to E (module docstring).
+
+    The set must stay independent as the model moves, not only at the initial configuration (a row
+    pair on a turning body is independent at most angles and dependent at some), so rows are taken
+    greedily in an order that makes that likely: rows touching no border coordinate first
+    (independent at every configuration: the model's rows are), then rows touching border
+    coordinates; rows of kinds that prefer the border (``CompiledConstraints.border``: a flexible
+    body's node frames, which fix massless node bodies) go to E at once.  A row joins R when it
+    adds to the rank of the rows taken, restricted to the blocks with mass, at the initial
+    configuration (Gram–Schmidt, relative tolerance 1e-9).  Returns ``(reg_rows, ext_rows)``.
+    """
+    J = model._Phi_q_all(0.0, model.q0).toarray()
+    cols = np.concatenate([np.arange(blk_v0[b], blk_v0[b] + blk_w[b]) for b in np.flatnonzero(massive)])
+    prefer_e = np.zeros(r_blk.shape[0], bool)
+    for rec in ckinds:
+        if getattr(rec, "border", False):
+            prefer_e[rec._row0:rec._row0 + rec.rows] = True
+    on_border = [any(blk_x[b] >= 0 for b in r_blk[a] if b >= 0) for a in range(r_blk.shape[0])]
+    order = sorted((a for a in reg_rows if not prefer_e[a]), key=lambda a: (on_border[a], a))
+    basis: list[np.ndarray] = []
+    keep_rows, moved = [], [a for a in reg_rows if prefer_e[a]]
+    for a in order:
+        r = J[a, cols].copy()
+        nrm = float(np.linalg.norm(r))
+        for _ in range(2):  # Gram–Schmidt, repeated once for orthogonality in floating point
+            for e in basis:
+                r -= (e @ r) * e
+        res = float(np.linalg.norm(r))
+        if nrm > 0.0 and res > 1e-9 * nrm:
+            basis.append(r / res)
+            keep_rows.append(a)
+        else:
+            moved.append(a)
+    return sorted(keep_rows), sorted(ext_rows + moved)
+
+
+def _mass_groups(model, mass_rec, nb: int, nvb: int, ne: int):
+    """The blocks of each mass group, from its velocity indices (whole blocks, checked):
+    ``(blk_g, blk_go, groups, group_blocks)`` — each block's group (−1: none) and first position in
+    it, each group's velocity indices and block list."""
+    n_blk = nb + 1 + ne
+    blk_g = np.full(n_blk, -1, np.int64)
+    blk_go = np.zeros(n_blk, np.int64)
+    groups = [] if mass_rec is None else [np.asarray(g, np.int64) for g in mass_rec.groups]
+    group_blocks: list[list[int]] = []
+    for g, vi in enumerate(groups):
+        blocks, o = [], 0
+        while o < len(vi):
+            j = int(vi[o])
+            b, w_ = (j // nvb, nvb) if j < nb * nvb else (nb + 1 + j - nb * nvb, 1)
+            start = j if b > nb else b * nvb
+            if j != start or not np.array_equal(vi[o:o + w_], np.arange(start, start + w_)) or blk_g[b] >= 0:
+                raise NotCompilable(f"model {model.name!r}: {mass_rec.what} {mass_rec.names[g]!r}: its velocity "
+                                    "indices are not whole blocks, or overlap another group")
+            blk_g[b], blk_go[b] = g, o
+            blocks.append(b)
+            o += w_
+        group_blocks.append(blocks)
+    return blk_g, blk_go, groups, group_blocks
+
+
+def _group_slots(model, ckinds, r_blk: np.ndarray, blk_g: np.ndarray, group_blocks, mass_rec):
+    """Give every row touching a block of a mass group a slot on every block of the group (protocol,
+    "Mass groups"), filled into ``r_blk`` from the last free slot down (:func:`core.compiled.dynamics.
+    constraints` zeroes their entries).  Returns ``(rg_cnt, rg, pad_slots)``: the groups of each row
+    and the (row, slot) pairs added; :class:`NotCompilable` naming the element when a row runs out
+    of slots."""
+    m_all = r_blk.shape[0]
+    pad = []
+    rg_cnt = np.zeros(m_all, np.int64)
+    rg = np.full((m_all, MAX_SLOTS), -1, np.int64)
+    if not group_blocks:
+        return rg_cnt, rg, np.zeros((0, 2), np.int64)
+    for rec in ckinds:
+        for i in range(rec.rows):
+            a = rec._row0 + i
+            for g in sorted({int(blk_g[b]) for b in r_blk[a] if b >= 0 and blk_g[b] >= 0}):
+                rg[a, rg_cnt[a]] = g
+                rg_cnt[a] += 1
+                for b in group_blocks[g]:
+                    if b in r_blk[a]:
+                        continue
+                    free = np.flatnonzero(r_blk[a] < 0)
+                    if free.size == 0:
+                        element = rec.names[i * len(rec.names) // rec.rows]  # rows are in element order
+                        raise NotCompilable(
+                            f"model {model.name!r}: {rec.what} {element!r} touches {mass_rec.what} "
+                            f"{mass_rec.names[g]!r}, whose mass matrix couples its frame with its "
+                            f"{len(group_blocks[g]) - 1} modal coordinates: a row then touches more than "
+                            f"{MAX_SLOTS} blocks; keep fewer modes or use the numpy integrators")
+                    r_blk[a, free[-1]] = b
+                    pad.append((a, int(free[-1])))
+    return rg_cnt, rg, np.array(pad, np.int64).reshape(-1, 2)
 
 
 def _label(kind) -> str:
@@ -565,7 +719,7 @@ def _stack(blocks: list[np.ndarray], dtype) -> tuple[np.ndarray, np.ndarray, np.
     return flat, off, rows, widths
 
 
-def _kernel_tuples(ckinds, fkinds) -> tuple[dict, np.ndarray]:
+def _kernel_tuples(ckinds, fkinds, mass_rec: CompiledMass | None = None) -> tuple[dict, np.ndarray]:
     cap = KIND_CAPACITY
 
     def res(k, role, sig, owner):
@@ -595,6 +749,11 @@ def _kernel_tuples(ckinds, fkinds) -> tuple[dict, np.ndarray]:
                   n_frc=len(fkinds), frc=frc, frc_fd=frc_fd, frc_fo=frc_fo, frc_n=frc_n, frc_fw=frc_fw,
                   frc_ix=frc_ix, frc_io=frc_io, frc_iw=frc_iw, frc_jac=frc_jac, frc_has_jac=frc_has_jac,
                   frc_acc=frc_acc, frc_stateful=frc_stateful, st_off=st_off, st_n=st_n, st_w=st_w)
+    if mass_rec is None:
+        fields.update(mass_k=(_no_mass.dispatcher,), mass_fd=np.zeros((1, 1)), mass_ix=np.zeros((1, 1), np.int64))
+    else:
+        fields.update(mass_k=(res(mass_rec.kernel, "mass", MASS_SIGNATURE, f"{mass_rec.what} {mass_rec.names[0]!r}"),),
+                      mass_fd=_f2(mass_rec.fd), mass_ix=_i2(mass_rec.ix))
     return fields, states
 
 
@@ -629,6 +788,8 @@ def status_message(cm, system, err, states, code, state=None) -> str:
     from . import protocol as _p
 
     why = _p.STATUS_MESSAGES.get(code, f"kernel status {code}")
+    if code == _p.MASS_NOT_PD and err[2] == 3:
+        return f"{cm.element_name('mass', int(err[0]), 0)}: {why}"
     if code in (_p.SINGULAR, _p.NONFINITE, _p.PROJECTION) or err[2] not in (1, 2):
         return why
     family = "force" if err[2] == 1 else "constraint"

@@ -38,6 +38,9 @@ force Jacobian             ``state``, ``K``, ``D`` (n_v, n_v): **adds** ∂Q/∂
                            increments and ∂Q/∂v (optional; the implicit integrators difference
                            the forces of kinds that do not supply it)
 accept                     ``state``: the search-state hook, called after accepted steps only
+mass                       ``Mg`` (n_groups, w, w): **writes** the mass matrix of every
+                           configuration-dependent mass group of the record (a flexible body
+                           with the deformed body's inertia), in the group's velocity order
 =========================  ======================================================================
 
 Constraint rows and their Jacobian slots
@@ -48,6 +51,17 @@ coordinate (one velocity coordinate).  ``CompiledConstraints.slots`` (rows, MAX_
 block of each slot — a body index ``0 … n_b − 1``, an extra coordinate ``n_b + 1 + k``, or −1
 (unused, or the ground) — and the kernel writes ``G[row, slot, :width]``.  Use
 :func:`body_slot` and :func:`extra_slot` to build the array.
+
+Mass groups
+-----------
+Most blocks have a constant mass block, inverted once when the model is packed.  A *mass group*
+(:class:`CompiledMass`) is a set of blocks whose joint mass matrix depends on the configuration —
+a flexible body with the inertia of the deformed body couples its frame with its modal
+coordinates through :math:`M(q_f)`.  Its mass kernel writes the group's matrix at every
+evaluation; the packer gives every constraint row that touches a block of a group a slot on every
+block of that group (the added slots' Jacobian entries stay zero), so that ``M⁻¹Φ_qᵀ`` of the row
+is complete on the group.  A row then touches at most :data:`MAX_SLOTS` blocks *including* the
+added ones.
 """
 
 from __future__ import annotations
@@ -61,12 +75,12 @@ from numba import types
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 __all__ = [
-    "OK", "SINGULAR", "COINCIDENT", "NONFINITE", "PROJECTION", "OUT_OF_RANGE", "ELEMENT_FAILED",
+    "OK", "SINGULAR", "COINCIDENT", "NONFINITE", "PROJECTION", "OUT_OF_RANGE", "ELEMENT_FAILED", "MASS_NOT_PD",
     "STATUS_MESSAGES", "WANT_PHI", "WANT_NU", "WANT_GAMMA", "WANT_ALL", "MAX_SLOTS", "LAYOUT_FIELDS",
     "L_NB", "L_DIM", "L_NQB", "L_NVB", "L_NQ", "L_NV", "L_NX",
-    "FORCE_SIGNATURE", "CONSTRAINT_SIGNATURE", "FORCE_JACOBIAN_SIGNATURE", "ACCEPT_SIGNATURE",
-    "Kernel", "force_kernel", "constraint_kernel", "force_jacobian_kernel", "accept_kernel", "resolve_kernel",
-    "CompiledForces", "CompiledConstraints", "body_slot", "extra_slot",
+    "FORCE_SIGNATURE", "CONSTRAINT_SIGNATURE", "FORCE_JACOBIAN_SIGNATURE", "ACCEPT_SIGNATURE", "MASS_SIGNATURE",
+    "Kernel", "force_kernel", "constraint_kernel", "force_jacobian_kernel", "accept_kernel", "mass_kernel",
+    "resolve_kernel", "CompiledForces", "CompiledConstraints", "CompiledMass", "body_slot", "extra_slot",
 ]
 
 # Calling kernels through numba's first-class function type is marked experimental by numba; its
@@ -75,7 +89,7 @@ warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning,
                         message=".*[Ff]irst-class function type.*")
 
 # --- status codes ---------------------------------------------------------------------------------
-OK, SINGULAR, COINCIDENT, NONFINITE, PROJECTION, OUT_OF_RANGE, ELEMENT_FAILED = 0, 1, 2, 3, 4, 5, 6
+OK, SINGULAR, COINCIDENT, NONFINITE, PROJECTION, OUT_OF_RANGE, ELEMENT_FAILED, MASS_NOT_PD = 0, 1, 2, 3, 4, 5, 6, 7
 STATUS_MESSAGES = {
     SINGULAR: "the constraint Schur complement Φ_q M⁻¹ Φ_qᵀ is not positive definite "
               "(dependent constraints or a singular configuration)",
@@ -84,6 +98,8 @@ STATUS_MESSAGES = {
     PROJECTION: "coordinate projection did not converge",
     OUT_OF_RANGE: "time outside the range of a tabulated function",
     ELEMENT_FAILED: "an element could not be evaluated",
+    MASS_NOT_PD: "the mass matrix of a body whose inertia follows its deformation is not positive definite "
+                 "(a deformation far beyond the range of its modes, or non-finite modal coordinates)",
 }
 
 # --- constraint kernel flags ---------------------------------------------------------------------
@@ -119,6 +135,8 @@ CONSTRAINT_SIGNATURE = _i8(*_common, _i8, _i8, _v, _m3, _v, _v, _iv)
 FORCE_JACOBIAN_SIGNATURE = _i8(*_common, _m2, _m2, _m2, _iv)
 #: ``(t, q, v, r, A, rd, w, lay, fd, ix, state, err) -> status``
 ACCEPT_SIGNATURE = _i8(*_common, _m2, _iv)
+#: ``(t, q, v, r, A, rd, w, lay, fd, ix, Mg, err) -> status``
+MASS_SIGNATURE = _i8(*_common, _m3, _iv)
 
 _JIT = dict(cache=True, fastmath=False, boundscheck=False, nogil=True)
 
@@ -172,6 +190,11 @@ def force_jacobian_kernel(fn) -> Kernel:
 def accept_kernel(fn) -> Kernel:
     """Declare ``fn`` a search-state kernel (:data:`ACCEPT_SIGNATURE`)."""
     return Kernel(fn, ACCEPT_SIGNATURE, "accept")
+
+
+def mass_kernel(fn) -> Kernel:
+    """Declare ``fn`` a mass kernel (:data:`MASS_SIGNATURE`)."""
+    return Kernel(fn, MASS_SIGNATURE, "mass")
 
 
 def resolve_kernel(k, role: str, signature, owner: str):
@@ -252,6 +275,11 @@ class CompiledConstraints:
     time_dependent : bool
         The rows depend on time explicitly (ν ≠ 0).
     what : str
+    border : bool
+        The rows fix massless coordinates (a flexible body's node frames): in a model with
+        border coordinates the packer solves them with the border (rows E of
+        :mod:`core.compiled.layout`) rather than in the Schur complement, whose rows must stay
+        independent as the model moves.
     """
 
     kernel: object
@@ -262,6 +290,33 @@ class CompiledConstraints:
     names: list[str]
     time_dependent: bool = False
     what: str = "constraint"
+    border: bool = False
+
+
+@dataclass
+class CompiledMass:
+    """Mass groups whose mass matrix depends on the configuration (see the module docstring).
+
+    Attributes
+    ----------
+    kernel : Kernel (:func:`mass_kernel`)
+        Writes ``Mg[g, :w_g, :w_g]`` of every group ``g`` (symmetric positive definite).
+    fd, ix : ndarray, 2-D (float64, int64)
+        The kernel's data.
+    groups : list of ndarray of int
+        Velocity indices of each group, in the order of the rows of its ``Mg`` block; a group
+        is made of whole blocks (all coordinates of a body, and extra coordinates).
+    names : list of str
+        Group names (one per group; a failure names the group).
+    what : str
+    """
+
+    kernel: object
+    fd: np.ndarray
+    ix: np.ndarray
+    groups: list
+    names: list[str]
+    what: str = "mass group"
 
 
 def body_slot(b: int, n_bodies: int) -> int:

@@ -86,8 +86,10 @@ frame's rotation rates are small against the modal frequencies and the deformati
 the body (a railway car body: rates of 0.01–0.1 rad/s against 50–100 rad/s), and it is wrong for
 fast-spinning bodies (the spin-up beam).  With mean-axis modes (free–free,
 ``orthonormalized(drop_rigid=True)``) and the frame origin at the centre of mass, :math:`\hat M_0` is
-block diagonal — a rigid body plus one oscillator per mode — which is the form the compiled
-integrators take (:mod:`core.flexible.compiled`).  Gravity keeps its full potential.
+block diagonal — a rigid body plus one oscillator per mode — which the compiled integrators
+invert once, as a rigid body (:mod:`core.flexible.compiled`; the full inertia, and a coupled
+:math:`\hat M_0`, they take as a mass group whose matrix is rebuilt at every evaluation).  Gravity
+keeps its full potential.
 
 Geometric stiffening
 --------------------

@@ -99,8 +99,11 @@ class _SpinUp:
 
 def spin_up_angle(omega_s: float = 6.0, T_s: float = 15.0) -> TimeFunction:
     """The hub angle θ(t) [rad] of the spin-up manoeuvre with its exact derivatives."""
+    # θ̇ is the cycloidal rest-to-rest law in the rate: θ is its time integral, which the compiled
+    # path evaluates with the same formulas (core.compiled.timefunctions, kind "cycloidal")
     return TimeFunction(_SpinUp(omega_s, T_s, 0), _SpinUp(omega_s, T_s, 1), _SpinUp(omega_s, T_s, 2),
-                        f"spin-up to {omega_s:g} rad/s in {T_s:g} s")
+                        f"spin-up to {omega_s:g} rad/s in {T_s:g} s",
+                        spec=("cycloidal", float(omega_s), float(T_s), 0.0, True))
 
 
 def spin_up_beam(n_elements: int = 20, n_modes: int = 4, geometric_stiffening: bool | str = True,

@@ -296,6 +296,16 @@ class Integrator:
             h = self.t_bound - self.t
         return h
 
+    # --- multipliers at output states ------------------------------------------------------------
+    def multipliers(self, t: float, q: Array, v: Array) -> Array:
+        """The index-1 multipliers λ at ``(t, q, v)`` (:func:`core.dynamics.accelerations`, no
+        Baumgarte terms): what :func:`core.simulation.simulate` reports, and the joint reactions it
+        computes, at output states where the method has none of its own.  The compiled integrators
+        evaluate the same equations on their compiled path."""
+        from ..dynamics import accelerations
+
+        return accelerations(self.system, t, q, v)[1]
+
     # --- dense output ---------------------------------------------------------------------------
     def dense_output(self) -> Callable[[float], tuple[Array, Array]]:
         """Interpolant of the last step, ``f(t) -> (q, v)`` for ``t_old ≤ t ≤ t``."""

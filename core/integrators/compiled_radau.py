@@ -84,8 +84,9 @@ P. E. Nikravesh, *Computer-Aided Analysis of Mechanical Systems*, Prentice Hall,
 from __future__ import annotations
 
 # numba bakes module constants such as protocol.MAX_SLOTS into its cached machine code and keys the
-# cache on this file only: this file changed with MAX_SLOTS (3 -> 8, flexible bodies' node frames),
-# so that no stale kernel of the old width runs (docs/architecture.md, numba's on-disk cache)
+# cache on this file only: this file changed with MAX_SLOTS (3 -> 8, flexible bodies' node frames)
+# and with the mass groups of core.compiled.dynamics (flexible bodies with the deformed body's
+# inertia), so that no stale kernel runs (docs/architecture.md, numba's on-disk cache)
 
 import numba
 import numpy as np
@@ -108,6 +109,7 @@ from .compiled_rk import (
     EXIT_REACHED,
     EXIT_TOO_SMALL,
     _rhs,
+    compiled_multipliers,
 )
 from .ggl import MAX_FACTOR, MIN_FACTOR, MU_COMPLEX, MU_REAL, NEWTON_MAXITER, P, T, TI
 from .ggl import C as RADAU_C
@@ -360,17 +362,27 @@ def _newton_solve(lay, q, mu, rw, nv, m, alpha, beta, A, piv, rq, rv, dq, dv, b,
 
 @_jit
 def _jacobian(cd, states, ws, rw, t, q, v):
-    """``K``, ``D`` and the active rows of ``Φ_q`` (dense) at ``(t, q, v)``; status."""
+    """``K``, ``D``, the mass matrix's configuration-dependent blocks (mass groups) and the active
+    rows of ``Φ_q`` (dense) at ``(t, q, v)``; status."""
     st = _d.force_jacobian(cd, states, ws, t, q, v, rw.K, rw.D, rw.qp, rw.vp, rw.Qa, rw.Qb)
     if st != _p.OK:
         return st
     act = cd.act
     m = act.shape[0]
     nv = rw.K.shape[0]
+    _d.body_states(cd.lay, q, v, ws)
+    if cd.n_grp:  # the mass groups' blocks of M at this state (the rest of M is constant)
+        st = _d.mass_update(cd, ws, t, q, v)
+        if st != _p.OK:
+            return st
+        Mden, Mg, grp_v, grp_w = rw.Mden, ws.Mg, cd.grp_v, cd.grp_w
+        for g in range(cd.n_grp):
+            for i in range(grp_w[g]):
+                for j in range(grp_w[g]):
+                    Mden[grp_v[g, i], grp_v[g, j]] = Mg[g, i, j]
     if m == 0:
         _pack(rw, nv, 0)
         return _p.OK
-    _d.body_states(cd.lay, q, v, ws)
     st = _d.constraints(cd, ws, t, q, v, 0)
     if st != _p.OK:
         return st
@@ -873,6 +885,9 @@ class CompiledRadau(Integrator):
         st = cm.initial_states()
         K, D = np.zeros((nv, nv)), np.zeros((nv, nv))
         pat = (np.abs(Mden) > 0).astype(float)
+        for g in range(cm.n_grp):  # a mass group's block is full whatever its entries at t0
+            vi = cm.fields["grp_v"][g, :cm.fields["grp_w"][g]]
+            pat[np.ix_(vi, vi)] = 1.0
         rng = np.random.default_rng(0)
         work = (np.zeros(system.n_q), np.zeros(nv), np.zeros(nv), np.zeros(nv))
         for q, v in ((self.q.copy(), self.v.copy()),
@@ -892,6 +907,11 @@ class CompiledRadau(Integrator):
         ip = np.empty(N, np.int64)
         ip[order] = np.arange(N)
         return ip
+
+    def multipliers(self, t, q, v):
+        """The index-1 multipliers at ``(t, q, v)`` on the compiled path
+        (:func:`core.integrators.compiled_rk.compiled_multipliers`)."""
+        return compiled_multipliers(self, t, q, v)
 
     def _evaluate(self, t, y, out):
         """``out = F(t, y)`` with the compiled right-hand side; kernel status code."""

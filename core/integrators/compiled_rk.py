@@ -47,8 +47,9 @@ E. Hairer, S. P. Nørsett, G. Wanner, *Solving Ordinary Differential Equations I
 from __future__ import annotations
 
 # numba bakes module constants such as protocol.MAX_SLOTS into its cached machine code and keys the
-# cache on this file only: this file changed with MAX_SLOTS (3 -> 8, flexible bodies' node frames),
-# so that no stale kernel of the old width runs (docs/architecture.md, numba's on-disk cache)
+# cache on this file only: this file changed with MAX_SLOTS (3 -> 8, flexible bodies' node frames)
+# and with the mass groups of core.compiled.dynamics (flexible bodies with the deformed body's
+# inertia), so that no stale kernel runs (docs/architecture.md, numba's on-disk cache)
 
 import numba
 import numpy as np
@@ -57,7 +58,7 @@ import scipy.integrate as _si
 from ..compiled import dynamics as _d
 from ..compiled import layout as _l
 from ..compiled import protocol as _p
-from ..errors import InputError, NotCompilable
+from ..errors import InputError, NotCompilable, NumericalFailure
 from .base import STATUS_FAILED, STATUS_RUNNING, Integrator, register
 from .index1 import DEFAULT_BAUMGARTE
 
@@ -286,6 +287,22 @@ def advance(cd, states, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, 
         counters[C_STEPS] += 1
 
 
+def compiled_multipliers(integ, t, q, v) -> np.ndarray:
+    """λ of :func:`core.compiled.dynamics.accelerations` without Baumgarte terms at ``(t, q, v)``
+    (equal to :func:`core.dynamics.accelerations`' to round-off, microseconds instead of a sparse
+    factorisation); the force kinds' search states are the run's.  :class:`NumericalFailure`
+    naming the cause when the equations cannot be evaluated there."""
+    cm = integ._cm
+    a = np.zeros(cm.n_v)
+    lam = np.zeros(max(cm.m, 1))
+    st = _d.accelerations(integ._cd, integ._states, integ._ws, float(t), np.ascontiguousarray(q, dtype=float),
+                          np.ascontiguousarray(v, dtype=float), 0.0, 0.0, a, lam)
+    if st != _p.OK:
+        raise NumericalFailure(f"{integ.name}: multipliers at t = {float(t):.6g} s: "
+                               f"{integ._status_message(st, (float(t), np.concatenate([q, v])))}")
+    return lam[:cm.m].copy()
+
+
 class CompiledRK(Integrator):
     """Index-1 formulation on a compiled explicit Runge–Kutta loop (see the module docstring).
 
@@ -401,6 +418,10 @@ class CompiledRK(Integrator):
                        self.stabilization == "projection", self.projection_tol, self.max_projection_iter,
                        self._stiff_bound, self._stiff_action, self._cm.stateful, self._K, self._y_new, self._y_old,
                        self._f_old, self._tmp, self._y_st, self._lam, self._cnt, self._info)
+
+    def multipliers(self, t, q, v):
+        """The index-1 multipliers at ``(t, q, v)`` on the compiled path (:func:`compiled_multipliers`)."""
+        return compiled_multipliers(self, t, q, v)
 
     def _evaluate(self, t, y, out):
         """``out = F(t, y)`` through the compiled loop's right-hand side; kernel status code."""

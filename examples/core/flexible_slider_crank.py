@@ -78,22 +78,22 @@ rows.append(res.summary_row("two-mode model (Simeon), dop853-projection rtol=1e-
 
 flexible = slider_crank_flexible(n_elements=elements, n_modes=modes)
 t0 = time.perf_counter()
-res = simulate(flexible, (0.0, 0.1), "radau-projection", rtol=1e-4, atol=1e-6, t_eval=t_eval)
+res = simulate(flexible, (0.0, 0.1), "jit-radau-projection", rtol=1e-4, atol=1e-6, t_eval=t_eval)
 P = np.array([[flexible.point_position(q, b, (0.0, 0.0)) for b in ("rod.A", "rod.mid", "rod.B")] for q in res.q])
 label = f"flexible body ({elements} elements, {1 + modes} modes) [mm]"
 histories[label] = 1e3 * chord_deflection(P[:, 0], P[:, 1], P[:, 2])
-rows.append(res.summary_row(f"flexible body, {elements} elements, {1 + modes} modes, radau-projection rtol=1e-4",
+rows.append(res.summary_row(f"flexible body, {elements} elements, {1 + modes} modes, jit-radau-projection rtol=1e-4",
                             {"wall [s]": time.perf_counter() - t0}))
 
 for n in scene.progress(links, desc="rigid-link rods"):
     chain = slider_crank_chain(n)
     t0 = time.perf_counter()
-    res = simulate(chain, (0.0, 0.1), "radau-projection", rtol=1e-6, atol=1e-8, t_eval=t_eval)
+    res = simulate(chain, (0.0, 0.1), "jit-radau-projection", rtol=1e-6, atol=1e-8, t_eval=t_eval)
     ell = SIMEON_ROD["l2"] / n
     P = np.array([[chain.point_position(q, "rod1", (-ell / 2, 0.0)), chain.point_position(q, f"rod{n // 2}", (ell / 2, 0.0)),
                    chain.point_position(q, f"rod{n}", (ell / 2, 0.0))] for q in res.q])
     histories[f"rigid-link rod ({n} links) [mm]"] = 1e3 * chord_deflection(P[:, 0], P[:, 1], P[:, 2])
-    rows.append(res.summary_row(f"rigid-link rod, {n} links, radau-projection rtol=1e-6",
+    rows.append(res.summary_row(f"rigid-link rod, {n} links, jit-radau-projection rtol=1e-6",
                                 {"wall [s]": time.perf_counter() - t0}))
 runs = scene.table("runs", pd.DataFrame(rows))
 

@@ -38,6 +38,7 @@ from core.compiled import (
 from core.compiled import dynamics as D
 from core.compiled import protocol as P
 from core.compiled.timefunctions import encode, evaluate
+from core.flexible.models import spin_up_angle
 from core.dynamics import accelerations as accelerations_numpy
 from core.errors import DataRangeError
 from core.forces import ForceElement, ForceEval, ForceJacobian, ForceKind
@@ -294,6 +295,8 @@ def test_rcm_envelope_is_a_band_on_chains():
     drivers.polynomial([0.1, -2.0, 0.7, 0.05]),
     drivers.harmonic(0.3, 4.0, 0.2, 1.0),
     drivers.tabulated(np.linspace(0.0, 2.0, 11), np.cos(np.linspace(0.0, 2.0, 11)) ** 2),
+    drivers.cycloidal(-1.2, 1.3, 0.4),  # rest, motion, rest on [0, 2]
+    spin_up_angle(6.0, 1.5),            # the cycloidal law's time integral: spin-up, then constant rate
 ])
 def test_compiled_time_functions_equal_the_numpy_ones(fn):
     prog = encode(fn, "test")

@@ -21,6 +21,7 @@ every model.
 module                 contents
 =====================  ========================================================================
 ``protocol``           kernel signatures and decorators, status codes, the records a kind returns
+                       (and a mass group: bodies whose mass matrix depends on the configuration)
 ``vector``             inlined 3-vector kinematics for writing kernels
 ``timefunctions``      compiled functions of time (ramp, harmonic, polynomial, tabulated spline)
 ``elements``           kernels of core's joints, drivers and force elements
@@ -37,11 +38,13 @@ from .protocol import (
     CONSTRAINT_SIGNATURE,
     FORCE_JACOBIAN_SIGNATURE,
     FORCE_SIGNATURE,
+    MASS_SIGNATURE,
     MAX_SLOTS,
     OK,
     STATUS_MESSAGES,
     CompiledConstraints,
     CompiledForces,
+    CompiledMass,
     Kernel,
     accept_kernel,
     body_slot,
@@ -49,6 +52,7 @@ from .protocol import (
     extra_slot,
     force_jacobian_kernel,
     force_kernel,
+    mass_kernel,
 )
 
 __all__ = [
@@ -61,17 +65,20 @@ __all__ = [
     "KIND_CAPACITY",
     "CompiledForces",
     "CompiledConstraints",
+    "CompiledMass",
     "Kernel",
     "force_kernel",
     "constraint_kernel",
     "force_jacobian_kernel",
     "accept_kernel",
+    "mass_kernel",
     "body_slot",
     "extra_slot",
     "FORCE_SIGNATURE",
     "CONSTRAINT_SIGNATURE",
     "FORCE_JACOBIAN_SIGNATURE",
     "ACCEPT_SIGNATURE",
+    "MASS_SIGNATURE",
     "MAX_SLOTS",
     "OK",
     "STATUS_MESSAGES",

@@ -49,6 +49,9 @@ from core.integrators import simulate
 from core.scenes import scene_run
 
 scene = scene_run("sar-antenna")
+# every run: Radau IIA with coordinate projection on the compiled path (the flexible panels are mass
+# groups there, core.flexible.compiled)
+METHOD = "jit-radau-projection"
 p = SAR_ANTENNA
 L, mu, EI = p["panel_length"], p["mass_per_length"], p["EI"]
 data = pd.DataFrame([
@@ -87,8 +90,6 @@ scene.table("panel_modes", pd.DataFrame(rows))
 # A fast unfolding (π/2 in 2 s) of one panel whose bus is held.  The reference
 # (:func:`core.flexible.models.driven_cantilever`) uses the exact Euler–Bernoulli cantilever modes,
 # linear in the deflection, without the centrifugal terms θ̇² (at most (θ̇/ω₁)² = 1.6e-3 here).
-#: every run: Radau IIA with coordinate projection on the compiled path
-METHOD = "jit-radau-projection"
 T1 = 2.0
 t1 = np.linspace(0.0, 2 * T1, 401)
 single = {"t [s]": t1}

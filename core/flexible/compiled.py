@@ -415,7 +415,7 @@ def inertia_records(rows: list[dict]) -> tuple[CompiledMass, CompiledForces]:
 
 @_inline
 def _offsets(m, nc):
-    """Offsets in a row of fd: mass, first moment, S, K, D, Gram, K_G."""
+    """Offsets of K, D, the Gram matrix and K_G in a row of fd (g at 0, the mass at 3, ∫ρx̄ at 4, S at 7)."""
     o_s = 7
     o_k = o_s + 3 * m
     o_d = o_k + m * m

@@ -225,7 +225,7 @@ def inverse_dynamics(trial: GaitTrial) -> pd.DataFrame:
     m = sm.model
     times = trial.kinematics.q["time"].to_numpy(float)
     t1 = time.perf_counter()
-    kin = kinematic_analysis(m, times, q_guess=m.q0)
+    kin = kinematic_analysis(m, times, q_guess=sm.q_frames)  # all frames at once (core.analysis)
     if kin.attrs["status"] != "finished":
         raise InputError(f"kinematic analysis of {trial.settings.get('motion')}: {kin.attrs['message']}")
     qn = [c for c in kin.columns[1:1 + m.n_q]]

@@ -34,7 +34,9 @@ def version() -> str:
 def run_inverse_dynamics(model_file, motion_file, external_loads_file, t0, t1, cutoff=6.0, out_dir=None):
     """OpenSim's InverseDynamicsTool (muscles excluded, coordinates low-passed at ``cutoff``).
 
-    Returns (DataFrame of generalized forces with ``time`` first, wall time of ``run()`` [s]).
+    Returns (DataFrame of generalized forces with ``time`` first, wall time [s] of OpenSim's
+    own work: loading the model, then ``run()`` (reading the motion and the loads, filtering,
+    inverse dynamics, writing the results); reading the results back into Python is not timed).
     """
     import opensim as osim
 
@@ -42,6 +44,7 @@ def run_inverse_dynamics(model_file, motion_file, external_loads_file, t0, t1, c
 
     out = Path(out_dir or tempfile.mkdtemp(prefix="mbsuite-opensim-id-"))
     out.mkdir(parents=True, exist_ok=True)
+    start = time.perf_counter()
     model = osim.Model(str(model_file))
     model.initSystem()
     tool = osim.InverseDynamicsTool()
@@ -56,7 +59,6 @@ def run_inverse_dynamics(model_file, motion_file, external_loads_file, t0, t1, c
     tool.setExcludedForces(excluded)
     tool.setResultsDir(str(out))
     tool.setOutputGenForceFileName("inverse_dynamics.sto")
-    start = time.perf_counter()
     if not tool.run():
         raise RuntimeError(f"OpenSim's InverseDynamicsTool failed on {motion_file}")
     wall = time.perf_counter() - start
@@ -68,7 +70,9 @@ def run_static_optimization(model_file, motion_file, external_loads_file, actuat
     """OpenSim's StaticOptimization analysis (AnalyzeTool), Σ activation^exponent, with the
     reserve actuators of ``actuators_file`` appended to the model's forces.
 
-    Returns (activations DataFrame, forces DataFrame, wall time of ``run()`` [s]).
+    Returns (activations DataFrame, forces DataFrame, wall time [s] of OpenSim's own work: loading
+    the tool with its model from the setup file, then ``run()``; writing the setup file and reading
+    the results back into Python are not timed).
     """
     import opensim as osim
 
@@ -100,8 +104,8 @@ def run_static_optimization(model_file, motion_file, external_loads_file, actuat
     tool.updAnalysisSet().cloneAndAppend(so)
     setup = out / "so_setup.xml"
     tool.printToXML(str(setup))
-    tool = osim.AnalyzeTool(str(setup))
     start = time.perf_counter()
+    tool = osim.AnalyzeTool(str(setup))
     ok = tool.run()
     wall = time.perf_counter() - start
     if not ok:

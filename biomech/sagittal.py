@@ -138,6 +138,31 @@ class _PlanarJoint:
                 out[j] += sign * float(f.derivative(q[j], order))
         return out
 
+    def terms(self, q):
+        """φ, ∂φ/∂q, ∂²φ/∂q², t, ∂t/∂q, ∂²t/∂q² for many frames at once: ``q`` (n_f, n) the
+        joint's coordinates; shapes (n_f,), (n_f, n), (n_f, n), (n_f, 2), (n_f, 2, n), (n_f, 2, n)
+        (the second derivatives are diagonal: each axis is a function of one coordinate)."""
+        nf, n = q.shape[0], len(self.coordinates)
+        ph, ph1, ph2 = np.zeros(nf), np.zeros((nf, n)), np.zeros((nf, n))
+        tt, t1, t2 = np.zeros((nf, 2)), np.zeros((nf, 2, n)), np.zeros((nf, 2, n))
+        for sign, j, f in self.rot:
+            if j < 0:
+                ph += sign * float(f.value(0.0))
+                continue
+            x = q[:, j]
+            ph += sign * f.value(x)
+            ph1[:, j] += sign * f.derivative(x, 1)
+            ph2[:, j] += sign * f.derivative(x, 2)
+        for a, j, f in self.trans:
+            if j < 0:
+                tt += a * float(f.value(0.0))
+                continue
+            x = q[:, j]
+            tt += np.outer(f.value(x), a)
+            t1[:, :, j] += np.outer(f.derivative(x, 1), a)
+            t2[:, :, j] += np.outer(f.derivative(x, 2), a)
+        return ph, ph1, ph2, tt, t1, t2
+
     def t(self, q, order=0):
         """t(q) (2,); order 1: ∂t/∂q_j as (2, n); order 2: ∂²t/∂q_j² as (2, n)."""
         n = len(self.coordinates)
@@ -220,12 +245,9 @@ def planar_forward_kinematics(osim, coordinates):
             oP, thP = pose[jt.parent]
             thF = thP + jt.beta_parent
             oF = oP + np.einsum("nij,j->ni", _R(thP), jt.l_parent)
-            phi = np.zeros(n)
-            tt = np.zeros((n, 2))
-            for k in range(n):
-                qk = np.array([qv[c][k if len(qv[c]) > 1 else 0] for c in jt.coordinates]) if jt.coordinates else np.zeros(0)
-                phi[k] = jt.phi(qk)
-                tt[k] = jt.t(qk)
+            qj = np.column_stack([np.broadcast_to(qv[c], (n,)) for c in jt.coordinates]) if jt.coordinates \
+                else np.zeros((n, 0))
+            phi, _, _, tt, _, _ = jt.terms(qj)
             thM = thF + phi
             oM = oF + np.einsum("nij,nj->ni", _R(thF), tt)
             thC = thM - jt.beta_child
@@ -372,6 +394,7 @@ class _DrivenPlanarJoints(UserConstraint):
         self.bC = np.array([j.jt.beta_child for j in self.joints])
         self.has_parent = self.P >= 0
         self._t_cached, self._cached = None, None
+        self._tf = None  # (times, terms) of _time_terms_frames
 
     def _time_terms(self, t):
         """Per joint: φ, t(q), R_F-free parts of ν and γ (module docstring), cached per time."""
@@ -402,13 +425,99 @@ class _DrivenPlanarJoints(UserConstraint):
 
     @staticmethod
     def _rot(th, u):
+        """R(θ) u for arrays of angles (...) and vectors (..., 2)."""
         c, s = np.cos(th), np.sin(th)
-        return np.stack([c * u[:, 0] - s * u[:, 1], s * u[:, 0] + c * u[:, 1]], axis=1)
+        return np.stack([c * u[..., 0] - s * u[..., 1], s * u[..., 0] + c * u[..., 1]], axis=-1)
 
     @staticmethod
     def _drot(th, u):
+        """B(θ) u = dR/dθ u, shapes as :meth:`_rot`."""
         c, s = np.cos(th), np.sin(th)
-        return np.stack([-s * u[:, 0] - c * u[:, 1], c * u[:, 0] - s * u[:, 1]], axis=1)
+        return np.stack([-s * u[..., 0] - c * u[..., 1], c * u[..., 0] - s * u[..., 1]], axis=-1)
+
+    # --- all frames at once (core.model.Model.constraint_terms_frames) --------------------------
+    def _time_terms_frames(self, t):
+        """Per frame and joint: φ, t(q), R_F-free parts of ν and γ (module docstring), shapes
+        (n_f, n_j), (n_f, n_j, 2), (n_f, n_j, 2), (n_f, n_j), (n_f, n_j, 2), (n_f, n_j); kept
+        for the last array of times (Newton's iterations and ν, γ share them)."""
+        if self._tf is not None and len(self._tf[0]) == len(t) and np.array_equal(self._tf[0], t):
+            return self._tf[1]
+        nf, n = len(t), len(self.joints)
+        PH, TQ, V1, W1 = np.zeros((nf, n)), np.zeros((nf, n, 2)), np.zeros((nf, n, 2)), np.zeros((nf, n))
+        A2, G2 = np.zeros((nf, n, 2)), np.zeros((nf, n))
+        for k, j in enumerate(self.joints):
+            if not j.jt.coordinates:
+                ph, _, _, tq, _, _ = j.jt.terms(np.zeros((nf, 0)))
+                PH[:, k], TQ[:, k] = ph, tq
+                continue
+            qm, qd, qdd = j.motion(t)
+            ph, ph1, ph2, tq, t1, t2 = j.jt.terms(qm)
+            PH[:, k], TQ[:, k] = ph, tq
+            V1[:, k], W1[:, k] = np.einsum("fin,fn->fi", t1, qd), np.sum(ph1 * qd, axis=1)
+            A2[:, k] = np.einsum("fin,fn->fi", t2, qd * qd) + np.einsum("fin,fn->fi", t1, qdd)
+            G2[:, k] = np.sum(ph2 * qd * qd, axis=1) + np.sum(ph1 * qdd, axis=1)
+        out = (PH, TQ, V1, W1, A2, G2)
+        self._tf = (np.array(t, float), out)
+        return out
+
+    def _poses_frames(self, q, v=None):
+        nf = q.shape[0]
+        x = q[:, self.q_index].reshape(nf, -1, 3)
+        hp = self.has_parent
+        Pi = np.where(hp, self.P, 0)
+        rP = np.where(hp[None, :, None], x[:, Pi, :2], 0.0)
+        thP = np.where(hp[None, :], x[:, Pi, 2], 0.0)
+        rC, thC = x[:, self.C, :2], x[:, self.C, 2]
+        if v is None:
+            return rP, thP, rC, thC
+        w = v[:, self.v_index].reshape(nf, -1, 3)[:, :, 2]
+        return rP, thP, rC, thC, np.where(hp[None, :], w[:, Pi], 0.0), w[:, self.C]
+
+    def phi_frames(self, t, q):
+        PH, TQ, *_ = self._time_terms_frames(t)
+        rP, thP, rC, thC = self._poses_frames(q)
+        thF = thP + self.bP
+        pos = rC + self._rot(thC, self.sC) - rP - self._rot(thP, self.sP) - self._rot(thF, TQ)
+        ang = thC + self.bC - thP - self.bP - PH
+        return np.concatenate([pos, ang[:, :, None]], axis=2).reshape(len(t), -1)
+
+    def jacobian_frames(self, t, q):
+        PH, TQ, *_ = self._time_terms_frames(t)
+        rP, thP, rC, thC = self._poses_frames(q)
+        thF = thP + self.bP
+        nf, n = len(t), len(self.joints)
+        J = np.zeros((nf, 3 * n, 3 * len(self.bodies)))
+        r0 = 3 * np.arange(n)
+        c0 = 3 * self.C
+        J[:, r0, c0] = 1.0
+        J[:, r0 + 1, c0 + 1] = 1.0
+        dC = self._drot(thC, self.sC)
+        J[:, r0, c0 + 2] = dC[..., 0]
+        J[:, r0 + 1, c0 + 2] = dC[..., 1]
+        J[:, r0 + 2, c0 + 2] = 1.0
+        k = np.nonzero(self.has_parent)[0]
+        p0 = 3 * self.P[k]
+        dP = -self._drot(thP[:, k], self.sP[k]) - self._drot(thF[:, k], TQ[:, k])
+        J[:, r0[k], p0] = -1.0
+        J[:, r0[k] + 1, p0 + 1] = -1.0
+        J[:, r0[k], p0 + 2] = dP[..., 0]
+        J[:, r0[k] + 1, p0 + 2] = dP[..., 1]
+        J[:, r0[k] + 2, p0 + 2] = -1.0
+        return J
+
+    def nu_frames(self, t, q):
+        _, _, V1, W1, _, _ = self._time_terms_frames(t)
+        rP, thP, rC, thC = self._poses_frames(q)
+        return np.concatenate([self._rot(thP + self.bP, V1), W1[:, :, None]], axis=2).reshape(len(t), -1)
+
+    def gamma_frames(self, t, q, v):
+        _, TQ, V1, _, A2, G2 = self._time_terms_frames(t)
+        rP, thP, rC, thC, wP, wC = self._poses_frames(q, v)
+        thF = thP + self.bP
+        wP2, wC2 = (wP**2)[:, :, None], (wC**2)[:, :, None]
+        g = (wC2 * self._rot(thC, self.sC) - wP2 * self._rot(thP, self.sP) - wP2 * self._rot(thF, TQ)
+             + 2.0 * wP[:, :, None] * self._drot(thF, V1) + self._rot(thF, A2))
+        return np.concatenate([g, G2[:, :, None]], axis=2).reshape(len(t), -1)
 
     def phi(self, t, q):
         PH, TQ, *_ = self._time_terms(t)
@@ -470,11 +579,16 @@ class SagittalModel:
         holds them as one vectorised constraint (:class:`_DrivenPlanarJoints`).
     rows : dict of str to (3,) int arrays
         The model's constraint rows of each joint (position x, y, angle).
+    q_frames : ndarray, shape (n_frames, n_q)
+        The model's Cartesian coordinates at the kinematics' frames from the forward kinematics of
+        the measured coordinates (:func:`planar_forward_kinematics`): the guess per frame with
+        which core's kinematic analysis solves all frames at once.
     """
 
-    def __init__(self, model, osim, joints, coordinates, kinematics):
+    def __init__(self, model, osim, joints, coordinates, kinematics, q_frames=None):
         self.model, self.osim, self.joints, self.coordinates = model, osim, joints, coordinates
         self.kinematics = kinematics
+        self.q_frames = q_frames
         all_rows = model.reaction_groups()[_DrivenPlanarJoints.name]
         if len(all_rows) != 3 * len(joints):
             raise ModelError(f"{osim.name}: dependent joint equations were removed at build; the driven "
@@ -492,15 +606,22 @@ class SagittalModel:
         ``t`` (n,), ``q`` (n, n_q) Cartesian coordinates, ``lam`` (n, n_c) multipliers.
         Columns ``time [s]`` and ``<coordinate>_moment [N m]`` / ``<coordinate>_force [N]``.
         """
-        cols = {"time [s]": np.asarray(t, float)}
+        t = np.atleast_1d(np.asarray(t, float))
+        q, lam = np.atleast_2d(q), np.atleast_2d(lam)
+        cols = {"time [s]": t}
         ctype = {c.name: c.motion_type for c in self.osim.coordinates}
         vals = {c: np.zeros(len(t)) for c in self.coordinates}
-        for uc in self.joints:
-            rows = self.rows[uc.name]
-            for i in range(len(t)):
-                tau = uc.generalized_forces(q[i], float(t[i]), lam[i, rows])
-                for c, v in zip(uc.jt.coordinates, tau):
-                    vals[c][i] = v
+        for uc in self.joints:  # τ = −(∂h/∂q)ᵀ λ, every frame at once
+            if not uc.jt.coordinates:
+                continue
+            lj = lam[:, self.rows[uc.name]]
+            _, ph1, _, _, t1, _ = uc.jt.terms(uc.motion(t)[0])
+            thF = uc.jt.beta_parent + (0.0 if uc.ground_parent else q[:, uc.q_index[2]])
+            c, s_ = np.cos(thF), np.sin(thF)
+            Ft = np.stack([c * lj[:, 0] + s_ * lj[:, 1], -s_ * lj[:, 0] + c * lj[:, 1]], axis=1)  # R_Fᵀ λ_pos
+            tau = -(np.einsum("fin,fi->fn", t1, Ft) + ph1 * lj[:, 2:3])
+            for k, name in enumerate(uc.jt.coordinates):
+                vals[name] = tau[:, k]
         for c in self.coordinates:
             unit = "N m" if ctype[c] == "rotational" else "N"
             kind = "moment" if ctype[c] == "rotational" else "force"
@@ -576,8 +697,8 @@ def build_sagittal_model(osim, kinematics, loads=None, name=None):
     for jt in _planar_joints(osim):
         idx = np.array([cindex[c] for c in jt.coordinates], int)
 
-        def motion(t, idx=idx):
-            return splines[0](t)[idx], splines[1](t)[idx], splines[2](t)[idx]
+        def motion(t, idx=idx):  # t a time, or an array of times: then (n_f, n) each
+            return splines[0](t)[..., idx], splines[1](t)[..., idx], splines[2](t)[..., idx]
 
         cP = np.zeros(2) if jt.parent == GROUND else np.asarray(bodies[jt.parent].mass_center, float)[:2]
         cC = np.asarray(bodies[jt.child].mass_center, float)[:2]
@@ -613,7 +734,8 @@ def build_sagittal_model(osim, kinematics, loads=None, name=None):
     # bodies are placed at the first frame; velocities (and, for a window not starting at t = 0,
     # the positions at t = 0 where core checks the initial state) by core's assembly
     model = b.build(assemble=True)
-    return SagittalModel(model, osim, joints, coords, kinematics)
+    q_frames = np.concatenate([np.column_stack([fk[body.name][2], fk[body.name][1]]) for body in osim.bodies], axis=1)
+    return SagittalModel(model, osim, joints, coords, kinematics, q_frames)
 
 
 def _time_column(df):

@@ -203,6 +203,8 @@ class _ClarabelData:
         self.cones = dims_to_solver_cones(data["dims"])
         self.cols = [(pp.var_id_to_col[v.id], v.size) for v in variables]
         self.solver = None
+        self._settings_key = None
+        self._P_triu = None
         self.verified = 0
         self.ok = self._matches(data)
 
@@ -211,10 +213,23 @@ class _ClarabelData:
         return self._ci.get_parameter_vector(pp.total_param_size, pp.param_id_to_col, pp.param_id_to_size,
                                              lambda i: np.asarray(pp.id_to_param[i].value))
 
-    def data(self):
+    def param_vec(self, values: dict):
+        """The parameter vector p from values given directly (parameter -> array), laid out as
+        cvxpy's ``get_parameter_vector`` lays out the parameters' own values (column-major, the
+        constant 1 at its column): no cvxpy value checks on the per-frame path."""
+        pp = self.pp
+        p = np.zeros(pp.total_param_size + 1)
+        for pid, col in pp.param_id_to_col.items():
+            if pid == self._ci.lo.CONSTANT_ID:
+                p[col] = 1.0
+            else:
+                p[col:col + pp.param_id_to_size[pid]] = np.asarray(values[pp.id_to_param[pid]], float).ravel(order="F")
+        return p
+
+    def data(self, p=None):
         import scipy.sparse as sp
 
-        flat = self.T @ self._param_vec()
+        flat = self.T @ (self._param_vec() if p is None else p)
         A = sp.csc_array((-flat[: self.nA], self.A_indices, self.A_indptr), shape=self.A_shape)
         b = np.zeros(self.A_shape[0])
         b[self.b_rows] = flat[self.nA:]
@@ -235,19 +250,29 @@ class _ClarabelData:
         self.verified += 1
         return self.ok
 
-    def solve(self, options):
-        """(status, solver time, iterations, [variable values]) with cvxpy's status names."""
+    def solve(self, options, p=None):
+        """(status, solver time, iterations, [variable values]) with cvxpy's status names; ``p``
+        the parameter vector (:meth:`param_vec`), default from the parameters' values.
+
+        The solver is built once; later frames with the same options pass Clarabel only the new
+        values of A's fixed pattern and b (``update(A=values, b=b)``, Clarabel's data update)."""
         import clarabel
         import scipy.sparse as sp
 
-        A, b = self.data()
-        n = self.A_shape[1]
-        P = sp.triu(self.P if self.P is not None else sp.csc_array((n, n))).tocsc()
-        settings = self._clarabel_if.parse_solver_opts(False, options)
-        if self.solver is None or not self.solver.is_data_update_allowed():
-            self.solver = clarabel.DefaultSolver(P, self.q, A, b, self.cones, settings)
+        flat = self.T @ (self._param_vec() if p is None else p)
+        b = np.zeros(self.A_shape[0])
+        b[self.b_rows] = flat[self.nA:]
+        key = tuple(sorted(options.items()))
+        if self.solver is None or key != self._settings_key or not self.solver.is_data_update_allowed():
+            A = sp.csc_array((-flat[: self.nA], self.A_indices, self.A_indptr), shape=self.A_shape)
+            n = self.A_shape[1]
+            if self._P_triu is None:
+                self._P_triu = sp.triu(self.P if self.P is not None else sp.csc_array((n, n))).tocsc()
+            settings = self._clarabel_if.parse_solver_opts(False, options)
+            self.solver = clarabel.DefaultSolver(self._P_triu, self.q, A, b, self.cones, settings)
+            self._settings_key = key
         else:
-            self.solver.update(A=A, b=b, settings=settings)
+            self.solver.update(A=-flat[: self.nA], b=b)
         sol = self.solver.solve()
         status = self._clarabel_if.STATUS_MAP.get(str(sol.status), "solver_error")
         x = np.asarray(sol.x, float)
@@ -682,13 +707,16 @@ class StaticOptimization:
         if reason:
             return self._empty("invalid_input", reason, 0.0)
         t0 = time.perf_counter()
-        self._B.value = R * A  # R diag(A)
-        self._b.value = tau - R @ P
+        values = {self._B: R * A, self._b: tau - R @ P}  # R diag(A), τ − R P
         if self._c is not None:
-            self._c.value = A / self.stress_force_scale
-            self._d.value = P / self.stress_force_scale
-        first = self._run_fast() if self._fast_enabled else None
+            values |= {self._c: A / self.stress_force_scale, self._d: P / self.stress_force_scale}
+        fast_ready = self._fast_enabled and self._fast is not None and self._fast.verified >= 2 and self._fast.ok
+        if not fast_ready:  # cvxpy's problem is solved or checked against: it reads the parameters
+            self._set_parameters(values)
+        first = self._run_fast(values if fast_ready else None) if self._fast_enabled else None
         if first is None:
+            if fast_ready:
+                self._set_parameters(values)
             first = self._run(self.problem, self._base_options)
         best, solver_time, notes = first, first.solver_time, []
         for retry in self.retry_options:
@@ -726,9 +754,16 @@ class StaticOptimization:
         return FrameSolution(a, forces, u, reserve_forces, residual, status, message,
                              self.objective_value(a, u, A, P), elapsed, solver_time, iters)
 
-    def _run_fast(self):
+    @staticmethod
+    def _set_parameters(values):
+        for par, val in values.items():
+            par.value = val
+
+    def _run_fast(self, values=None):
         """The frame through :class:`_ClarabelData` (cvxpy's parameter tensor applied directly); None
-        where it cannot be used or did not end 'optimal' (the caller then solves with cvxpy)."""
+        where it cannot be used or did not end 'optimal' (the caller then solves with cvxpy).
+        ``values`` the parameters' values once the map is verified (else they are set on cvxpy's
+        parameters already)."""
         cp = self._cp
         try:
             if self._fast is None:
@@ -740,7 +775,8 @@ class StaticOptimization:
             if not self._fast.ok:
                 self._fast_enabled = False
                 return None
-            status, solve_time, iters, values = self._fast.solve(self._base_options)
+            p = None if values is None else self._fast.param_vec(values)
+            status, solve_time, iters, values = self._fast.solve(self._base_options, p)
         except Exception:  # an internal API of cvxpy that changed: use problem.solve from now on
             self._fast_enabled = False
             return None

@@ -206,10 +206,23 @@ def kinematic_analysis(system: ConstrainedSystem, times: ArrayLike, q_guess: Arr
         ``n_v − rank Φ_q`` must be 0 at the first time.
     times : array_like, shape (n_t,)
         Strictly increasing output times [s].
-    q_guess : array_like, shape (n_q,), optional
-        Guess at ``times[0]``; default ``system.q0``.
+    q_guess : array_like, shape (n_q,) or (n_t, n_q), optional
+        Guess at ``times[0]``; default ``system.q0``.  A guess *per frame* (a measured motion's
+        forward kinematics, say) makes the frames independent: they are then solved all at once
+        (below).
     tol, max_iter :
         As :func:`assemble_state`.
+
+    Notes
+    -----
+    *All frames at once.*  With a guess per frame and a system that offers
+    ``constraint_terms_frames`` (:class:`core.model.Model`), every frame runs the same Newton
+    iteration ``Δq = −Φ_q⁻¹Φ`` side by side (one batched LU solve of the square Φ_q per
+    iteration, until ``max|Φ| ≤ tol·max(1, max|q|)`` in every frame), then ``v = Φ_q⁻¹ν`` and
+    ``a = Φ_q⁻¹γ``: the same equations and tolerance as the frame-by-frame path.  When a frame
+    does not converge within ``max_iter``, or Φ_q is not square or not regular in some frame
+    (condition test of ``_frames_inverse``), the whole analysis runs frame by frame instead
+    (:func:`assemble_state`, with backtracking and least squares).
 
     Returns
     -------
@@ -229,11 +242,27 @@ def kinematic_analysis(system: ConstrainedSystem, times: ArrayLike, q_guess: Arr
         raise InputError("kinematic_analysis: times must be a non-empty, strictly increasing array")
     qn, vn, an = _names(system)
     q = np.asarray(system.q0 if q_guess is None else q_guess, float)
+    if q.ndim == 2:
+        if q.shape != (len(times), system.n_q):
+            raise InputError(f"kinematic_analysis: q_guess has shape {q.shape}, expected ({system.n_q},) or "
+                             f"({len(times)}, {system.n_q}) (one guess per time)")
+        if hasattr(system, "constraint_terms_frames"):
+            out = _kinematic_frames(system, times, q, tol, max_iter)
+            if out is not None:
+                df = pd.DataFrame(np.column_stack([times, *out]), columns=["t [s]", *qn, *vn, *an])
+                df.attrs.update(status="finished", message="", analysis="kinematic", system=system.name)
+                return df
+        guesses = q
+        q = guesses[0]
+    else:
+        guesses = None
     rows: list[np.ndarray] = []
     status, message = "finished", ""
     v = a = None
     for i, t in enumerate(times):
-        if i > 0:
+        if guesses is not None:
+            q = guesses[i]
+        elif i > 0:
             dt = t - times[i - 1]
             q = system.retract(q, v * dt + 0.5 * a * dt * dt)
         try:
@@ -258,6 +287,74 @@ def kinematic_analysis(system: ConstrainedSystem, times: ArrayLike, q_guess: Arr
     if status == "failed":
         warnings.warn(message, AnalysisWarning, stacklevel=2)
     return df
+
+
+def _frames_solve(J: Array, b: Array) -> Array | None:
+    """``x`` with ``J x = b`` frame by frame (J (n_f, n, n), b (n_f, n)) by one batched LU solve;
+    None when J is not square or a frame's J is singular or the result is not finite."""
+    if J.shape[1] != J.shape[2]:
+        return None
+    try:
+        x = np.linalg.solve(J, b[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return None
+    return x if np.all(np.isfinite(x)) else None
+
+
+def _frames_inverse(J: Array) -> Array | None:
+    """``J⁻¹`` of every frame (J (n_f, n, n)) when each is regular in the sense of the
+    frame-by-frame least squares, else None.
+
+    Regular means ``κ₁(J) = ‖J‖₁‖J⁻¹‖₁ ≤ 1/(n·RANK_RCOND)``: since ``κ₂ ≤ n·κ₁`` (Golub & Van
+    Loan 2013, Sec. 2.3.2, the norm equivalences), every singular value is then above
+    ``RANK_RCOND·σ_max``, no singular value would be truncated by the least squares
+    (:func:`core.dynamics.minimum_norm_multipliers`), and its minimum-norm solution is ``J⁻¹b``.
+    """
+    from .dynamics import RANK_RCOND
+
+    n = J.shape[1]
+    if J.shape[2] != n or n == 0:
+        return None
+    try:
+        Ji = np.linalg.inv(J)
+    except np.linalg.LinAlgError:
+        return None
+    if not np.all(np.isfinite(Ji)):
+        return None
+    kappa = np.abs(J).sum(axis=1).max(axis=1) * np.abs(Ji).sum(axis=1).max(axis=1)
+    return Ji if np.all(kappa <= 1.0 / (n * RANK_RCOND)) else None
+
+
+def _kinematic_frames(system, times, q, tol, max_iter):
+    """Positions, velocities and accelerations of all frames at once (:func:`kinematic_analysis`,
+    Notes); None to fall back to the frame-by-frame path."""
+    n_f = len(times)
+    q = system.normalize(q.copy()) if hasattr(system, "normalize") and system.space.dim == 3 else q.copy()
+    if system.n_c != system.n_v:
+        return None
+    scale = np.maximum(1.0, np.max(np.abs(q), axis=1))
+    done = False
+    for _ in range(max_iter + 1):
+        phi, J, _, _ = system.constraint_terms_frames(times, q)
+        if not np.all(np.isfinite(phi)):
+            return None
+        if np.all(np.max(np.abs(phi), axis=1) <= tol * scale):
+            done = True
+            break
+        dv = _frames_solve(J, -phi)
+        if dv is None:
+            return None
+        q = np.array([system.retract(q[i], dv[i]) for i in range(n_f)]) if system.space.dim == 3 else q + dv
+        scale = np.maximum(1.0, np.max(np.abs(q), axis=1))
+    if not done:
+        return None
+    _, J, nu, _ = system.constraint_terms_frames(times, q)
+    Ji = _frames_inverse(J)  # None also for free degrees of freedom: the frame-by-frame path names them
+    if Ji is None:
+        return None
+    v = np.einsum("fij,fj->fi", Ji, nu)
+    ga = system.constraint_terms_frames(times, q, v)[3]
+    return q, v, np.einsum("fij,fj->fi", Ji, ga)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -567,16 +664,20 @@ def inverse_dynamics(system: ConstrainedSystem, t: ArrayLike, q: ArrayLike, v: A
     cnames = list(getattr(system, "constraint_names", []) or [f"Phi[{i}]" for i in range(system.n_c)])
     drv = _driver_rows(system, drivers)
     rnames = system.reaction_names()
-    L = np.zeros((n_t, system.n_c))
-    res = np.zeros(n_t)
-    reac: dict[str, list[Array]] = {}
-    for i in range(n_t):
-        M = system.M(t[i], q[i])
-        rhs = np.asarray(system.Q(t[i], q[i], v[i]), float) - np.asarray(M @ a[i]).ravel()
-        J = system.Phi_q(t[i], q[i])
-        L[i], res[i] = minimum_norm_multipliers(J, rhs)
-        for name, val in system.reactions(t[i], q[i], L[i]).items():
-            reac.setdefault(name, []).append(np.asarray(val, float))
+    batched = _inverse_dynamics_frames(system, t, q, v, a) if hasattr(system, "Q_frames") else None
+    if batched is not None:
+        L, res, reac = batched
+    else:
+        L = np.zeros((n_t, system.n_c))
+        res = np.zeros(n_t)
+        reac = {}
+        for i in range(n_t):
+            M = system.M(t[i], q[i])
+            rhs = np.asarray(system.Q(t[i], q[i], v[i]), float) - np.asarray(M @ a[i]).ravel()
+            J = system.Phi_q(t[i], q[i])
+            L[i], res[i] = minimum_norm_multipliers(J, rhs)
+            for name, val in system.reactions(t[i], q[i], L[i]).items():
+                reac.setdefault(name, []).append(np.asarray(val, float))
     cols: dict[str, Array] = {"t [s]": t}
     for k, n in enumerate(cnames):
         cols[f"lambda[{n}]"] = L[:, k]
@@ -594,6 +695,26 @@ def inverse_dynamics(system: ConstrainedSystem, t: ArrayLike, q: ArrayLike, v: A
     df.attrs.update(analysis="inverse dynamics", system=system.name, max_residual=float(res.max(initial=0.0)),
                     drivers=list(drv))
     return df
+
+
+def _inverse_dynamics_frames(system, t, q, v, a):
+    """``(λ, residual, reactions)`` of all frames at once when Φ_q is square and regular in every
+    frame (``λ = Φ_q⁻ᵀ(Q − M a)`` with the batched inverse of ``_frames_inverse``: the unique
+    multipliers, equal to the minimum-norm ones); None otherwise (the frame-by-frame least squares
+    then runs)."""
+    if system.n_c != system.n_v or system.n_c == 0:
+        return None
+    J = system.constraint_terms_frames(t, q)[1]
+    rhs = system.Q_frames(t, q, v) - np.einsum("fij,fj->fi", system.M_frames(t, q), a)
+    if not (np.all(np.isfinite(J)) and np.all(np.isfinite(rhs))):
+        return None
+    Ji = _frames_inverse(J)
+    if Ji is None:
+        return None
+    lam = np.einsum("fji,fj->fi", Ji, rhs)  # λ = Φ_q⁻ᵀ (Q − M a)
+    res = np.linalg.norm(np.einsum("fji,fj->fi", J, lam) - rhs, axis=1)
+    reac = system.reactions_frames(t, q, lam, J=J)
+    return lam, res, reac
 
 
 def inverse_dynamics_from_result(system: ConstrainedSystem, result, method: str = "differentiate",

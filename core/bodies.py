@@ -204,6 +204,28 @@ class BodyStates:
             xdot = np.asarray(v[nb * space.n_v:], float)
         return cls(space, r, A, vb[:, : space.dim], vb[:, space.dim :], x, xdot)
 
+    @classmethod
+    def from_frames(cls, space: Space, n_bodies: int, q: Array, v: Array | None) -> BodyStates:
+        """Body states of many configurations at once: ``q`` (n_f, n_q), ``v`` (n_f, n_v) or None.
+
+        Every array gains a leading frame axis: ``r`` (n_f, n_bodies + 1, d), ``A`` (n_f,
+        n_bodies + 1, d, d), ``rdot``, ``w``, ``x`` (n_f, n_extra), ``xdot``.  Force kinds that
+        offer ``evaluate_frames`` read these (:meth:`core.model.Model.Q_frames`).
+        """
+        nb, nf = n_bodies, q.shape[0]
+        qb = np.zeros((nf, nb + 1, space.n_q))
+        qb[:, :nb] = q[:, : nb * space.n_q].reshape(nf, nb, space.n_q)
+        if space.dim == 3:
+            qb[:, nb, 3] = 1.0
+        A = space.rotation(qb.reshape(-1, space.n_q)).reshape(nf, nb + 1, space.dim, space.dim)
+        vb = np.zeros((nf, nb + 1, space.n_v))
+        x = np.asarray(q[:, nb * space.n_q:], float)
+        xdot = np.zeros_like(x)
+        if v is not None:
+            vb[:, :nb] = v[:, : nb * space.n_v].reshape(nf, nb, space.n_v)
+            xdot = np.asarray(v[:, nb * space.n_v:], float)
+        return cls(space, qb[..., : space.dim], A, vb[..., : space.dim], vb[..., space.dim :], x, xdot)
+
     # --- point kinematics for element arrays (index arrays into bodies) -------------------
     def point(self, b: NDArray[np.int64], s: Array) -> Array:
         """Global position of body-fixed points, shape (n, d)."""

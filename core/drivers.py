@@ -54,6 +54,18 @@ class TimeFunction:
     def __call__(self, t: float) -> tuple[float, float, float]:
         return float(self.f(t)), float(self.fd(t)), float(self.fdd(t))
 
+    def values(self, t, order: int = 0) -> np.ndarray:
+        """The value (``order`` 0) or a derivative (1, 2) at many times, shape of ``t``.
+
+        Tables and closed forms evaluate the array in one call; a user's callable, which may take
+        scalars only, is called once per time.
+        """
+        fn = (self.f, self.fd, self.fdd)[order]
+        t = np.asarray(t, float)
+        if isinstance(fn, _RangeGuard):
+            return np.asarray(fn.many(t), float)
+        return np.array([float(fn(ti)) for ti in t.ravel()]).reshape(t.shape)
+
     def __repr__(self) -> str:
         return f"TimeFunction({self.label})"
 
@@ -108,6 +120,16 @@ class _RangeGuard:
         lo, hi = self.lo, self.hi
         if not self.extrapolate and (tt < lo - 1e-12 * max(1, abs(lo)) or tt > hi + 1e-12 * max(1, abs(hi))):
             raise DataRangeError(f"table {self.label!r}: time {tt} outside the tabulated range [{lo}, {hi}]")
+        return self.fn(tt)
+
+    def many(self, tt: np.ndarray):
+        """Evaluate at an array of times (the same range check on each)."""
+        lo, hi = self.lo, self.hi
+        if not self.extrapolate and tt.size:
+            bad = (tt < lo - 1e-12 * max(1, abs(lo))) | (tt > hi + 1e-12 * max(1, abs(hi)))
+            if np.any(bad):
+                t0 = float(tt.ravel()[np.flatnonzero(bad.ravel())[0]])
+                raise DataRangeError(f"table {self.label!r}: time {t0} outside the tabulated range [{lo}, {hi}]")
         return self.fn(tt)
 
 

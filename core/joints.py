@@ -356,6 +356,15 @@ class UserConstraint:
     The coaster's path-following joint, with the arc length as an extra coordinate, is one.
     ``compiled(layout)`` may supply a compiled kernel (:mod:`core.compiled`).
 
+    Optional, for analyses of a prescribed motion whose frames are independent
+    (:meth:`core.model.Model.constraint_terms_frames`): the same four quantities at many states at
+    once, ``t`` (n_f,), ``q`` (n_f, n_q), ``v`` (n_f, n_v) the full vectors,
+
+    * ``phi_frames(t, q) -> (n_f, rows)``, ``jacobian_frames(t, q) -> (n_f, rows, len(v_index))``,
+    * ``nu_frames(t, q) -> (n_f, rows)``, ``gamma_frames(t, q, v) -> (n_f, rows)``.
+
+    Without them the model evaluates the frames one by one.
+
     Attributes
     ----------
     name : str

@@ -29,7 +29,7 @@ from .assembly import assemble as assemble_model
 from .assembly import check_initial_state
 from .bodies import PLANAR, SPATIAL, Body, BodyStates, Space
 from .constraints import PrimitiveKind
-from .errors import ModelError, RedundantConstraintError
+from .errors import InputError, ModelError, RedundantConstraintError
 from .forces import ForceElement, ForceJacobian, ForceKind
 from .joints import (
     Cylindrical,
@@ -44,7 +44,7 @@ from .joints import (
     Universal,
     UserConstraint,
 )
-from .system import ConstrainedSystem
+from .system import ConstrainedSystem, as_dense
 
 Array = NDArray[np.float64]
 GROUND = "ground"
@@ -1113,6 +1113,142 @@ class Model(ConstrainedSystem):
         if self._active_rows is not None:
             J = J[self._active_rows]
         return self._select(cat(phi)), J, self._select(cat(nu)), self._select(cat(ga))
+
+    # --- many frames at once (analyses of a prescribed motion) -------------------------------
+    def _frames_args(self, t, q, v=None):
+        t = np.atleast_1d(np.asarray(t, float))
+        q = np.atleast_2d(np.asarray(q, float))
+        if q.shape != (len(t), self.n_q):
+            raise InputError(f"model {self.name!r}: q has shape {q.shape} for {len(t)} frames, expected "
+                             f"({len(t)}, {self.n_q})")
+        if v is not None:
+            v = np.atleast_2d(np.asarray(v, float))
+            if v.shape != (len(t), self.n_v):
+                raise InputError(f"model {self.name!r}: v has shape {v.shape} for {len(t)} frames, expected "
+                                 f"({len(t)}, {self.n_v})")
+        return t, q, v
+
+    @property
+    def frames_vectorised(self) -> bool:
+        """True when :meth:`constraint_terms_frames` evaluates every frame in one call per element
+        (no joint kinds, and every user constraint offers ``phi_frames``); otherwise it loops over
+        the frames (same numbers, slower)."""
+        return not self.kinds and all(hasattr(uc, "phi_frames") for uc in self.user_constraints)
+
+    def constraint_terms_frames(self, t, q, v=None):
+        r"""``(Φ, Φ_q, ν, γ)`` at many states: ``t`` (n_f,), ``q`` (n_f, n_q), ``v`` (n_f, n_v) or None.
+
+        Returns Φ (n_f, n_c), a *dense* Φ_q (n_f, n_c, n_v), ν (n_f, n_c) and γ (n_f, n_c) (None
+        without ``v``): the same rows as :meth:`constraint_terms`.  User constraints that offer
+        ``phi_frames``, ``jacobian_frames``, ``nu_frames`` and ``gamma_frames``
+        (:class:`core.joints.UserConstraint`) are evaluated for all frames in one call; anything
+        else frame by frame.  For analyses of a prescribed motion, whose frames are independent
+        (:func:`core.analysis.kinematic_analysis` with a guess per frame,
+        :func:`core.analysis.inverse_dynamics`).
+        """
+        t, q, v = self._frames_args(t, q, v)
+        nf = len(t)
+        if not self.frames_vectorised:
+            out = [self.constraint_terms(t[i], q[i], np.zeros(self.n_v) if v is None else v[i]) for i in range(nf)]
+            phi = np.array([o[0] for o in out]).reshape(nf, self.n_c)
+            J = np.array([as_dense(o[1]) for o in out]).reshape(nf, self.n_c, self.n_v)
+            nu = np.array([o[2] for o in out]).reshape(nf, self.n_c)
+            ga = None if v is None else np.array([o[3] for o in out]).reshape(nf, self.n_c)
+            return phi, J, nu, ga
+        n_all = self._n_c_all
+        phi, nu = np.zeros((nf, n_all)), np.zeros((nf, n_all))
+        ga = None if v is None else np.zeros((nf, n_all))
+        J = np.zeros((nf, n_all, self.n_v))
+        r0 = 0
+        for uc in self.user_constraints:
+            rows = slice(r0, r0 + uc.rows)
+            phi[:, rows] = uc.phi_frames(t, q)
+            J[:, rows, uc.v_index] = uc.jacobian_frames(t, q)
+            nu[:, rows] = uc.nu_frames(t, q)
+            if v is not None:
+                ga[:, rows] = uc.gamma_frames(t, q, v)
+            r0 += uc.rows
+        if self._active_rows is not None:
+            a = self._active_rows
+            phi, J, nu = phi[:, a], J[:, a], nu[:, a]
+            ga = None if ga is None else ga[:, a]
+        return phi, J, nu, ga
+
+    def Q_frames(self, t, q, v) -> Array:
+        """Generalized forces ``Q(t, q, v)`` at many states, shape (n_f, n_v).
+
+        Gravity and the gyroscopic terms for all frames at once; force kinds that offer
+        ``evaluate_frames`` (:class:`core.forces.protocol.ForceKind`) in one call, the others frame
+        by frame; flexible bodies frame by frame.
+        """
+        t, q, v = self._frames_args(t, q, v)
+        nf, nb = len(t), self.n_bodies
+        nvb = self.space.n_v
+        Q = np.repeat(self._Qg[None, :], nf, axis=0)
+        if self.space.dim == 3 and nb:
+            w = v[:, : nb * 6].reshape(nf, nb, 6)[:, :, 3:]
+            gyro = np.zeros((nf, nb, 6))
+            gyro[:, :, 3:] = -np.cross(w, np.einsum("nij,fnj->fni", self._J, w))
+            Q[:, : nb * 6] += gyro.reshape(nf, nb * 6)
+        if self.force_kinds:
+            acc = np.zeros((nb + 1, nf, nvb))
+            accx = np.zeros((len(self.extra_names), nf))
+            bsf = None
+            for fk in self.force_kinds:
+                if hasattr(fk, "evaluate_frames"):
+                    if bsf is None:
+                        bsf = BodyStates.from_frames(self.space, nb, q, v)
+                    ev = fk.evaluate_frames(bsf, t)
+                    np.add.at(acc, ev.bodies, np.swapaxes(ev.Qb, 0, 1))
+                    if len(ev.coords):
+                        np.add.at(accx, ev.coords, np.swapaxes(ev.Qx, 0, 1))
+                    continue
+                for i in range(nf):
+                    ev = fk.evaluate(self.body_states(q[i], v[i]), t[i])
+                    np.add.at(acc[:, i], ev.bodies, ev.Qb)
+                    if len(ev.coords):
+                        np.add.at(accx[:, i], ev.coords, ev.Qx)
+            Q[:, : nb * nvb] += np.swapaxes(acc[:nb], 0, 1).reshape(nf, nb * nvb)
+            Q[:, nb * nvb:] += accx.T
+        if self.flexible:
+            for i in range(nf):
+                for f, (_, Qb) in zip(self.flexible, self._flexible_terms(q[i], v[i])):
+                    Q[i, f.vi] += Qb
+        return Q
+
+    def M_frames(self, t, q) -> Array:
+        """Mass matrices at many configurations, dense (n_f, n_v, n_v) (one shared matrix,
+        broadcast, unless the model has flexible bodies)."""
+        t, q, _ = self._frames_args(t, q)
+        if not self.flexible:
+            return np.broadcast_to(as_dense(self._M), (len(t), self.n_v, self.n_v))
+        return np.array([as_dense(self.M(t[i], q[i])) for i in range(len(t))])
+
+    def reactions_frames(self, t, q, lam, J=None) -> dict[str, Array]:
+        """:meth:`reactions` at many frames: per joint an array (n_f, 3) planar or (n_f, 6)
+        spatial.  ``J`` the dense Φ_q of the frames (n_f, n_c, n_v) if already computed."""
+        t, q, _ = self._frames_args(t, q)
+        lam = np.atleast_2d(np.asarray(lam, float))
+        if J is None:
+            J = self.constraint_terms_frames(t, q)[1]
+        groups = self.reaction_groups()
+        A = BodyStates.from_frames(self.space, self.n_bodies, q, None).A
+        d, nvb = self.space.dim, self.space.n_v
+        out = {}
+        for name, (kb, sloc) in self._reaction_points.items():
+            rows = groups.get(name)
+            if rows is None or len(rows) == 0 or kb >= self.n_bodies:
+                continue
+            Qc = -np.einsum("frc,fr->fc", J[:, rows, kb * nvb:(kb + 1) * nvb], lam[:, rows])
+            F = Qc[:, :d]
+            arm = np.einsum("fij,j->fi", A[:, kb], sloc)
+            if d == 2:
+                Mp = Qc[:, 2] - (arm[:, 0] * F[:, 1] - arm[:, 1] * F[:, 0])
+                out[name] = np.column_stack([F, Mp])
+            else:
+                Mp = np.einsum("fij,fj->fi", A[:, kb], Qc[:, 3:]) - np.cross(arm, F)
+                out[name] = np.concatenate([F, Mp], axis=1)
+        return out
 
     # --- energy and reactions ------------------------------------------------------------------
     def energy(self, t: float, q: Array, v: Array) -> float:

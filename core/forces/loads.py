@@ -47,6 +47,14 @@ def _eval_components(const: Array, funcs: list, t: float) -> Array:
     return out
 
 
+def _eval_components_frames(const: Array, funcs: list, t: Array) -> Array:
+    """The components at many times, shape (n_f, n): each time function evaluated on the array."""
+    out = np.repeat(const[None, :], len(t), axis=0)
+    for k, fn in funcs:
+        out[:, k] = fn.values(t)
+    return out
+
+
 
 # --------------------------------------------------------------------------------------------
 # applied loads
@@ -133,6 +141,17 @@ class AppliedForceKind(ForceKind):
     def evaluate(self, bs, t):
         _, F = self._F(bs, t)
         return ForceEval(self.b, np.einsum("ndk,nd->nk", point_jacobian(bs, self.b, self.s), F))
+
+    def evaluate_frames(self, bsf, t):
+        """:meth:`evaluate` at the frames of ``bsf`` (:meth:`core.bodies.BodyStates.from_frames`),
+        times ``t`` (n_f,): ``Qb`` (n_f, n, n_v) = J_Pᵀ F per frame."""
+        nf, n, d = len(t), len(self.b), bsf.space.dim
+        Fc = np.stack([_eval_components_frames(c, f, t) for c, f in zip(self.const, self.funcs)], axis=1)
+        A = bsf.A[:, self.b]  # (n_f, n, d, d)
+        F = np.where(self.body_frame[None, :, None], np.einsum("fnij,fnj->fni", A, Fc), Fc)
+        C = bsf.space.C(A.reshape(-1, d, d), np.broadcast_to(self.s, (nf, n, d)).reshape(-1, d))
+        Qb = np.concatenate([F, np.einsum("mdk,md->mk", C, F.reshape(-1, d)).reshape(nf, n, -1)], axis=2)
+        return ForceEval(self.b, Qb)
 
     def jacobian(self, bs, t):
         Fc, Fg = self._F(bs, t)
@@ -225,6 +244,17 @@ class AppliedTorqueKind(ForceKind):
         _, Tb = self._torques(bs, t)
         Q = np.zeros((len(self.b), nv))
         Q[:, d:] = Tb
+        return ForceEval(self.b, Q)
+
+    def evaluate_frames(self, bsf, t):
+        """:meth:`evaluate` at the frames of ``bsf``, times ``t`` (n_f,): ``Qb`` (n_f, n, n_v)."""
+        d, nv = bsf.space.dim, bsf.space.n_v
+        Tc = np.stack([_eval_components_frames(c, f, t) for c, f in zip(self.const, self.funcs)], axis=1)
+        Tb = Tc
+        if d == 3:
+            Tb = np.where(self.body_frame[None, :, None], Tc, np.einsum("fnji,fnj->fni", bsf.A[:, self.b], Tc))
+        Q = np.zeros((len(t), len(self.b), nv))
+        Q[:, :, d:] = Tb
         return ForceEval(self.b, Q)
 
     def jacobian(self, bs, t):

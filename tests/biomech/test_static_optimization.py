@@ -375,6 +375,12 @@ def test_direct_route_equals_cvxpy_solve(criterion):
     assert list(a["status"]) == list(b["status"]) == ["optimal"] * 12
     cols = [c for c in a.columns if c.startswith(("a_", "u_"))]
     np.testing.assert_allclose(a[cols].to_numpy(), b[cols].to_numpy(), atol=1e-6)
+    # the parameter vector written directly (no cvxpy value checks) is cvxpy's own layout
+    values = {fast._B: R[-1] * A[-1], fast._b: tau[-1] - R[-1] @ P[-1]}
+    if criterion == "stress":
+        values |= {fast._c: A[-1] / fast.stress_force_scale, fast._d: P[-1] / fast.stress_force_scale}
+    fast._set_parameters(values)
+    np.testing.assert_array_equal(fast._fast.param_vec(values), fast._fast._param_vec())
 
 
 def test_direct_route_failure_falls_back_to_cvxpy(monkeypatch):
@@ -385,7 +391,7 @@ def test_direct_route_failure_falls_back_to_cvxpy(monkeypatch):
     R, A, P, tau = synthetic_frames(rng, muscles, pattern, 3)
     so = StaticOptimization.from_muscles(muscles, coords, reserve_optimal_force=1.0)
 
-    def broken(self, options):
+    def broken(self, options, p=None):
         raise RuntimeError("an internal API of cvxpy changed")
 
     monkeypatch.setattr(so_mod._ClarabelData, "solve", broken)

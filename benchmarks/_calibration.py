@@ -25,7 +25,9 @@ import _numpy_baseline as npb
 WORKLOAD = ("plain numpy + scipy 8-link rigid chain (dense KKT, scipy DOP853, rtol 1e-8, 1 s; "
             "benchmarks/_numpy_baseline.py)")
 
-__all__ = ["WORKLOAD", "calibrate", "calibration_line"]
+__all__ = ["WORKLOAD", "calibrate", "calibration_line", "header_lines", "with_calibration"]
+
+_UNITS = {"[s]": 1.0, "[ms]": 1e-3, "[us]": 1e-6, "[µs]": 1e-6}
 
 
 def calibrate(repeats: int = 5) -> float:
@@ -43,3 +45,24 @@ def calibration_line(seconds: float) -> str:
     """The header line that states the calibration and how to read the ``/ calibration`` columns."""
     return (f"Calibration: the {WORKLOAD} took {seconds:.4f} s (best of 5) in this run; a column "
             f"'/ calibration' gives a time as a multiple of it, comparable between hosts")
+
+
+def header_lines(seconds: float) -> list[str]:
+    """The processor line and the calibration line, for a results file or a printed table."""
+    from _host import host_line
+
+    return [f"Host: {host_line()}.", f"{calibration_line(seconds)}."]
+
+
+def with_calibration(table, seconds: float, columns=None):
+    """``table`` with a column ``<column> / calibration [-]`` after each time column (a unit of
+    ``[s]``, ``[ms]`` or ``[us]`` in its name, or the given ``columns``): the time divided by the
+    calibration workload's time measured in the same run."""
+    out = table.copy()
+    names = [c for c in out.columns if any(str(c).endswith(u) for u in _UNITS)] if columns is None else list(columns)
+    for c in names:
+        unit = next((u for u in _UNITS if str(c).endswith(u)), "[s]")
+        base = str(c)[: -len(unit)].rstrip() if str(c).endswith(unit) else str(c)
+        pos = list(out.columns).index(c) + 1
+        out.insert(pos, f"{base} / calibration [-]", out[c].astype(float) * _UNITS[unit] / seconds)
+    return out

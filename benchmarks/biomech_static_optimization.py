@@ -117,5 +117,9 @@ if __name__ == "__main__":
     parser.add_argument("--frames", type=int, default=200)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
+    from _calibration import calibrate, header_lines, with_calibration
+
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
-    print(main(args.frames, args.seed).to_markdown(index=False, floatfmt=".3g"))
+    cal = calibrate()
+    print("\n".join(header_lines(cal)))
+    print(with_calibration(main(args.frames, args.seed), cal, ["median [ms]"]).to_markdown(index=False, floatfmt=".3g"))

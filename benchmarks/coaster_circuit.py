@@ -117,15 +117,20 @@ def main(argv=None):
     args = ap.parse_args(argv)
     from core.results import markdown_table
 
+    from _calibration import calibrate, header_lines, with_calibration
+
     RESULTS.mkdir(exist_ok=True)
+    cal = calibrate()
     rt = real_time((1e-6, 1e-8) if args.quick else (1e-6, 1e-8, 1e-10))
     wp = work_precision(args.quick)
+    rt = with_calibration(rt, cal, ["integration wall [s]"])
+    wp = with_calibration(wp, cal, ["wall [s]"])
     rt.to_csv(RESULTS / "coaster_real_time.csv", index=False)
     wp.to_csv(RESULTS / "coaster_work_precision.csv", index=False)
     _plot(wp, RESULTS / "coaster_work_precision.png")
     text = ["# Coaster circuit: real-time factor and work-precision", "",
             f"Python {sys.version.split()[0]}, {time.strftime('%Y-%m-%d')}; one process; see the module docstring "
-            "of benchmarks/coaster_circuit.py for what is measured.", "",
+            "of benchmarks/coaster_circuit.py for what is measured.", "", *header_lines(cal), "",
             "## Full circuit, one lap without dissipation", "", markdown_table(rt), "",
             "## Error against run time, 20 s of the Outbound descent", "", markdown_table(wp), "",
             "![work-precision](coaster_work_precision.png)", ""]

@@ -102,9 +102,14 @@ def main(argv=None) -> int:
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--span", type=float, default=4.0, help="simulated seconds of the curving run")
     args = p.parse_args(argv)
+    from _calibration import WORKLOAD, calibrate, with_calibration
+
+    cal = calibrate()
     rows = _saddle_cases(args.rounds) + [_history_case(args.rounds, args.span)]
-    table = pd.DataFrame(rows)
+    table = with_calibration(pd.DataFrame(rows), cal, ["new [s]", "before [s]"])
     table["host"] = host_line()
+    table["calibration [s]"] = cal
+    table["calibration workload"] = WORKLOAD
     write_table(table, Path(__file__).resolve().parent / "results", "main_job_speedups")
     print(host_line())
     print(table.drop(columns="host").to_string())

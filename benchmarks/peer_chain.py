@@ -383,6 +383,10 @@ def main(argv=None) -> int:
         f"exudyn {sys.modules['exudyn'].__version__ if have_exudyn else '-'}, "
         f"machine {platform.machine()} ({os.cpu_count()} cores), {cpu_model()}, "
         f"load average at start {os.getloadavg()[0]:.2f}")
+    from _calibration import calibrate, calibration_line, with_calibration
+
+    cal = calibrate()
+    log(calibration_line(cal))
     if not have_exudyn:
         log(EXUDYN_MISSING)
     log(f"tools: {', '.join(tools)}")
@@ -483,13 +487,13 @@ def main(argv=None) -> int:
                 row["target ratio vs Exudyn <= 1"] = ""
             summ_rows.append(row)
         # write what we have after every case (a later case may be interrupted)
-        write_table(pd.DataFrame(summ_rows), out, "peer_chain_summary")
+        write_table(with_calibration(pd.DataFrame(summ_rows), cal, ["median wall [s]"]), out, "peer_chain_summary")
         write_table(pd.DataFrame(cfg_rows), out, "peer_chain_configs")
         write_table(pd.DataFrame(sweep_rows), out, "peer_chain_sweep")
         write_table(pd.DataFrame(ref_rows), out, "peer_chain_references", floatfmt=".12g")
         (out / "peer_chain_log.txt").write_text("\n".join(lines) + "\n")
 
-    summary = pd.DataFrame(summ_rows)
+    summary = with_calibration(pd.DataFrame(summ_rows), cal, ["median wall [s]"]) if summ_rows else pd.DataFrame()
     log("\n## Summary (time to tip error <= 1e-6 m at t = 1 s; ratios = this tool's median / peer's median)")
     if not have_exudyn:
         log(EXUDYN_MISSING)

@@ -1108,13 +1108,18 @@ def main(argv=None) -> int:
         f"machine {platform.machine()} ({os.cpu_count()} cores), {processor}, "
         f"load average at start {os.getloadavg()[0]:.2f}")
     log(f"host: {host_line()}")
+    from _calibration import calibrate, calibration_line, with_calibration
+
+    cal = calibrate()
+    log(calibration_line(cal))
     if not have_exudyn:
         log(EXUDYN_MISSING)
     run_exudyn = have_exudyn and "exudyn" in tools
     ref_rows, sweep_rows, cfg_rows, summ_rows, agree_rows, check_rows = [], [], [], [], [], []
 
     def write_all():
-        write_table(pd.DataFrame(summ_rows), out, "peer_flexible_summary")
+        write_table(with_calibration(pd.DataFrame(summ_rows), cal, ["median wall [s]"]) if summ_rows else pd.DataFrame(),
+                    out, "peer_flexible_summary")
         write_table(pd.DataFrame(cfg_rows), out, "peer_flexible_configs")
         write_table(pd.DataFrame(sweep_rows), out, "peer_flexible_sweep")
         write_table(pd.DataFrame(ref_rows), out, "peer_flexible_references", floatfmt=".10g")
@@ -1210,7 +1215,7 @@ def main(argv=None) -> int:
             summ_rows.append(row)
         write_all()
 
-    summary = pd.DataFrame(summ_rows)
+    summary = with_calibration(pd.DataFrame(summ_rows), cal, ["median wall [s]"]) if summ_rows else pd.DataFrame()
     log("\n## Summary (time for the quantity's error over the output grid to reach the target, relative to the peak; "
         "ratio = mbsuite median / Exudyn median)")
     if not have_exudyn:

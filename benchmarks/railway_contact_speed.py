@@ -147,6 +147,12 @@ def main():
                              f"({nc:.1f} loaded contacts)", wall * 1e6, cpu * 1e6, "us", "< 200 us"))
 
     out = pd.DataFrame(rows, columns=["case", "wall", "CPU", "unit", "target"])
+    from _calibration import calibrate, header_lines
+
+    cal = calibrate()
+    scale = out["unit"].map({"s": 1.0, "us": 1e-6})
+    out.insert(2, "wall / calibration [-]", out["wall"] * scale / cal)
+    print("\n".join(header_lines(cal)))
     print(out.to_markdown(index=False, floatfmt=".3g"))
     con = conicity_table(df, [0.002, 0.003, 0.004])
     y_f, g_f = flange_contact_onset(df)

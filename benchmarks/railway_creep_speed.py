@@ -55,6 +55,11 @@ def main(n: int = 10_000, n_loop: int = 200, seed: int = 0) -> pd.DataFrame:
         rows.append((name, n, t_vec, t_vec / n * 1e6, ratio))
     df = pd.DataFrame(rows, columns=["law", "n contacts", "wall [s]", "per contact [us]",
                                      "loop/vectorised [-]"])
+    from _calibration import calibrate, header_lines, with_calibration
+
+    cal = calibrate()
+    df = with_calibration(df, cal, ["wall [s]"])
+    print("\n".join(header_lines(cal)))
     print(df.to_markdown(index=False, floatfmt=".4g"))
     return df
 

@@ -31,6 +31,9 @@ def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--law", default="polach2000")
     args = p.parse_args(argv)
+    from _calibration import WORKLOAD, calibrate, with_calibration
+
+    cal = calibrate()
     out = nonlinear_critical_speed(dict(law=args.law, two_rate=True, bisect=True))
     row = out["row"]
     two_rate_cost = row["run-down wall time [s]"] + row["slow run-downs wall time [s]"]
@@ -50,7 +53,10 @@ def main(argv=None) -> int:
         "cost ratio two-rate / bisection": two_rate_cost / bisection_cost,
         "constant-speed runs": row["constant-speed runs"],
         "host": host_line(),
+        "calibration [s]": cal,
+        "calibration workload": WORKLOAD,
     }])
+    table = with_calibration(table, cal, ["two-rate wall time [s]", "bisection wall time [s]"])
     folder = Path(__file__).resolve().parent / "results"
     write_table(table, folder, "railway_critical_speed")
     print(host_line())

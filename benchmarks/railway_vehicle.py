@@ -290,17 +290,22 @@ def main(argv=None):
         print(write_test_states())
         return 0
 
+    from _calibration import calibrate, calibration_line, with_calibration
+
     RESULTS.mkdir(exist_ok=True)
     load0 = os.getloadavg()[0]
-    wp = work_precision(args.quick)
-    rt = pd.DataFrame([real_time()])
+    cal = calibrate()
+    wp = with_calibration(work_precision(args.quick), cal, ["wall time [s]"])
+    rt = with_calibration(pd.DataFrame([real_time()]), cal, ["wall time, integration [s]"])
     acc = accuracy_against_speed()
+    acc = with_calibration(acc, cal, ["wall time, integration [s]"])
     tc = timed_cases()
     load1 = os.getloadavg()[0]
     for name, df in (("railway_vehicle_work_precision", wp), ("railway_vehicle_real_time", rt),
                      ("railway_vehicle_real_time_accuracy", acc), ("railway_vehicle_timed", tc)):
         df.to_csv(RESULTS / f"{name}.csv", index=False)
-    text = ["# Railway vehicle benchmarks", "", f"host: {host_line()}", "", f"load average {load0:.2f} -> {load1:.2f}", "",
+    text = ["# Railway vehicle benchmarks", "", f"host: {host_line()}", "", f"{calibration_line(cal)}.", "",
+            f"load average {load0:.2f} -> {load1:.2f}", "",
             "## Work-precision, 5 s of curving (20 m/s, Polach 2000)", "", markdown_table(wp, floatfmt=".4g"), "",
             "## Real-time factor, 30 s on the 200 m curve", "", markdown_table(rt.T.reset_index(), floatfmt=".4g"), "",
             "## Real-time factor against accuracy, the same 30 s", "", f"Reference: {acc.attrs['reference']}.", "",

@@ -39,13 +39,13 @@ from core.compiled.protocol import (
 from core.curves import TabulatedFramedCurve
 from core.errors import NotCompilable
 
-_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+_internal = numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 HEADER = 14
 _NEEDED = (0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 27, 28, 29, 30, 31, 32)
 
 
-@_inline
+@_internal
 def _table_eval(fd, s, out):
     """Needed columns of the table at arc length s into ``out`` (45,)."""
     s0, length, closed, n, k1 = fd[0, 0], fd[0, 1], fd[0, 2], int(fd[0, 3]), int(fd[0, 4])
@@ -192,7 +192,7 @@ def compile_path_joint(joint, layout) -> CompiledConstraints:
 TF_HEADER = 7
 
 
-@_inline
+@_internal
 def _step(x):
     if x <= 0.0:
         return 0.0

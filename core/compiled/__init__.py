@@ -27,11 +27,16 @@ module                 contents
 ``elements``           kernels of core's joints, drivers and force elements
 ``layout``             packing a model: blocks, rows, Schur pattern, kernel tuples
 ``dynamics``           forces, constraints, saddle-point solves, accelerations, projection
+``cache``              numba's disk cache keyed on every compiled source of mbsuite
 =====================  ========================================================================
 """
 
-from ..errors import NotCompilable
-from .dynamics import Workspace, make_workspace
+from . import cache as _cache
+
+_cache.install()  # before any submodule decorates a cached function (core.compiled.cache)
+
+from ..errors import NotCompilable  # noqa: E402
+from .dynamics import Workspace, make_workspace  # noqa: E402
 from .layout import KIND_CAPACITY, CompiledModel, Layout, compile_model
 from .protocol import (
     ACCEPT_SIGNATURE,

@@ -53,7 +53,7 @@ __all__ = ["Workspace", "make_workspace", "body_states", "forces", "constraints"
            "FAMILY_FORCE", "FAMILY_CONSTRAINT"]
 
 _jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
-_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+_internal = numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 #: a Cholesky pivot below this fraction of its diagonal entry means numerically dependent rows
 PIVOT_RTOL = 1e-12
@@ -87,7 +87,7 @@ class Workspace(structref.StructRefProxy):
     """
 
     def __new__(cls, *values):
-        obj = structref.StructRefProxy.__new__(cls, *values)
+        obj = _new_workspace(*values)
         obj._arrays = dict(zip(WORKSPACE_FIELDS, values))
         return obj
 
@@ -99,6 +99,13 @@ class Workspace(structref.StructRefProxy):
 
 
 structref.define_proxy(Workspace, WorkspaceType, list(WORKSPACE_FIELDS))
+
+
+@numba.njit(cache=True)
+def _new_workspace(*values):
+    """Built in compiled code cached on disk (``StructRefProxy.__new__`` compiles an uncached
+    constructor in every process; see :func:`core.compiled.layout._new_compiled_data`)."""
+    return Workspace(*values)
 
 
 def make_workspace(cm) -> Workspace:
@@ -243,18 +250,18 @@ def retract(lay, q, dv):
 # slower on the Schur assembly).
 
 
-@_inline
+@_internal
 def _ffd(cd, k):
     """Data of force kind ``k`` (a C-contiguous view of the flat storage)."""
     return cd.frc_fd[cd.frc_fo[k]:cd.frc_fo[k + 1]].reshape((cd.frc_n[k], cd.frc_fw[k]))
 
 
-@_inline
+@_internal
 def _fix(cd, k):
     return cd.frc_ix[cd.frc_io[k]:cd.frc_io[k + 1]].reshape((cd.frc_n[k], cd.frc_iw[k]))
 
 
-@_inline
+@_internal
 def _fst(cd, states, k):
     return states[cd.st_off[k]:cd.st_off[k + 1]].reshape((cd.st_n[k], cd.st_w[k]))
 
@@ -348,7 +355,7 @@ def mass_update(cd, ws, t, q, v):
     return OK
 
 
-@_inline
+@_internal
 def _spd_inverse(Mg, Mi, g, n):
     """``Mi[g] = Mg[g]⁻¹`` of a symmetric positive definite ``n × n`` block (Cholesky: the factor in
     the lower triangle of ``Mi[g]``, then ``L⁻¹`` and ``L⁻ᵀL⁻¹``); False if not positive definite."""
@@ -384,7 +391,7 @@ def _spd_inverse(Mg, Mi, g, n):
     return True
 
 
-@_inline
+@_internal
 def _group_times(Mi, grp_v, g, n, src, dst):
     """``dst[v_g] = M_g⁻¹ src[v_g]`` over the velocity indices ``v_g`` of group ``g``."""
     for i in range(n):
@@ -421,7 +428,7 @@ def accept(cd, states, ws, t, q, v):
 # Schur assembly of the 32-link chain was measured 3× slower.
 
 
-@_inline
+@_internal
 def _minv_times(minv, b, wdt, src, so, dst, do):
     """``dst[do:do+w] = M_b⁻¹ src[so:so+w]``."""
     if wdt == 3:
@@ -438,7 +445,7 @@ def _minv_times(minv, b, wdt, src, so, dst, do):
         dst[do] = minv[b, 0, 0] * src[so]
 
 
-@_inline
+@_internal
 def _minv_times_row(minv, b, wdt, G, X, a, sl):
     """``X[a, sl] = M_b⁻¹ G[a, sl]`` (one Jacobian row block)."""
     if wdt == 3:
@@ -455,7 +462,7 @@ def _minv_times_row(minv, b, wdt, G, X, a, sl):
         X[a, sl, 0] = minv[b, 0, 0] * G[a, sl, 0]
 
 
-@_inline
+@_internal
 def _block_dot(G, a, sa, X, b, sb, wdt):
     """``G[a, sa] · X[b, sb]`` over a block of width ``wdt``."""
     if wdt == 3:
@@ -466,7 +473,7 @@ def _block_dot(G, a, sa, X, b, sb, wdt):
     return G[a, sa, 0] * X[b, sb, 0]
 
 
-@_inline
+@_internal
 def _block_dot_vec(G, a, sl, x, o, wdt):
     """``G[a, sl] · x[o:o+w]``."""
     if wdt == 3:
@@ -477,7 +484,7 @@ def _block_dot_vec(G, a, sl, x, o, wdt):
     return G[a, sl, 0] * x[o]
 
 
-@_inline
+@_internal
 def _block_sub(x, o, X, a, sl, mk, wdt):
     """``x[o:o+w] -= X[a, sl] mk``."""
     if wdt == 3:
@@ -501,7 +508,7 @@ def factor(cd, ws):
                    cd.blk_g, cd.blk_go, cd.grp_w, cd.rg_cnt, cd.rg, ws.Mgi, ws.gx, ws.gy)
 
 
-@_inline
+@_internal
 def _factor(reg, first, r_blk, blk_x, blk_w, minv, pat, ext, rs_cnt, rs, nx, xm, hpat, epat, S, L, G, X, C, W, T,
             piv, blk_g, blk_go, grp_w, rg_cnt, rg, Mgi, gx, gy):
     """:func:`factor` on arrays (inlined where the caller has loaded them once)."""
@@ -578,7 +585,7 @@ def _factor(reg, first, r_blk, blk_x, blk_w, minv, pat, ext, rs_cnt, rs, nx, xm,
     return _lu_factor(T, nz, piv)
 
 
-@_inline
+@_internal
 def _group_row(Mgi, g, n, blk_g, blk_go, rs_cnt, rs, G, X, a, gx, gy):
     """``X[a] = M_g⁻¹ G[a]`` on the blocks of group ``g`` (the row holds a slot on each of them)."""
     for c in range(n):
@@ -602,7 +609,7 @@ def _group_row(Mgi, g, n, blk_g, blk_go, rs_cnt, rs, G, X, a, gx, gy):
                 X[a, sl, c] = gy[o + c]
 
 
-@_inline
+@_internal
 def _solve_envelope(L, first, m, b):
     """Solve ``L Lᵀ x = b`` in place with the envelope factor."""
     for i in range(m):
@@ -645,7 +652,7 @@ def _lu_factor(T, n, piv):
     return OK
 
 
-@_inline
+@_internal
 def _lu_solve(T, n, piv, b):
     for k in range(n):
         p = piv[k]
@@ -675,7 +682,7 @@ def saddle_solve(cd, ws, f, g, x, mu):
             cd.grp_w, ws.Mgi)
 
 
-@_inline
+@_internal
 def _saddle(reg, first, blk_v0, blk_w, blk_x, minv, ext, rs_cnt, rs, mass_blocks, nx, G, X, rhs, z, L, C, W, T, piv,
             f, g, x, mu, n_grp, grp_v, grp_w, Mgi):
     """:func:`saddle_solve` on arrays (inlined where the caller has loaded them once)."""
@@ -736,7 +743,7 @@ def _saddle(reg, first, blk_v0, blk_w, blk_x, minv, ext, rs_cnt, rs, mass_blocks
                     x[blk_v0[b] + c] = z[blk_x[b] + c]
 
 
-@_inline
+@_internal
 def _row_dot(r_blk, blk_v0, blk_w, G, a, x):
     """``(Φ_q x)_a`` for model row ``a``."""
     acc = 0.0
@@ -805,7 +812,7 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
     return OK
 
 
-@_inline
+@_internal
 def _max_abs_phi(act, phi):
     mx = 0.0
     for k in range(act.shape[0]):
@@ -832,7 +839,7 @@ def project(cd, ws, t, q, v, tol, max_iter, counters):
     for i in range(zero_f.shape[0]):
         zero_f[i] = 0.0
     body_states(lay, q, v, ws)
-    if constraints(cd, ws, t, q, v, WANT_PHI) != OK:
+    if constraints(cd, ws, t, q, v, np.int64(WANT_PHI)) != OK:
         return -1
     err = _max_abs_phi(act, phi)
     n_iter = 0
@@ -851,7 +858,7 @@ def project(cd, ws, t, q, v, tol, max_iter, counters):
             # rewrites Φ and the G blocks, which saddle_solve reads for the right-hand side only:
             # they are restored at the velocity stage, which re-evaluates and refactorises)
             body_states(lay, q, v, ws)
-            if constraints(cd, ws, t, q, v, WANT_PHI) != OK:
+            if constraints(cd, ws, t, q, v, np.int64(WANT_PHI)) != OK:
                 return -1
             err = _max_abs_phi(act, phi)
             if err <= tol:
@@ -862,7 +869,7 @@ def project(cd, ws, t, q, v, tol, max_iter, counters):
         normalize(lay, q)
     # velocities at the projected positions: Φ_q (v + Δv) = ν, M-orthogonal
     body_states(lay, q, v, ws)
-    if constraints(cd, ws, t, q, v, WANT_NU) != OK:
+    if constraints(cd, ws, t, q, v, np.int64(WANT_NU)) != OK:
         return -1
     if mass_update(cd, ws, t, q, v) != OK or factor(cd, ws) != OK:
         return -1

@@ -65,7 +65,7 @@ from .protocol import (
 from .timefunctions import encode_rows
 from .timefunctions import evaluate as tf_evaluate
 
-_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+_internal = numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 
 def pad3(a) -> np.ndarray:
@@ -221,7 +221,7 @@ def distance(t, q, v, r, A, rd, w, lay, fd, ix, row0, flags, phi, G, nu, gam, er
     return OK
 
 
-@_inline
+@_internal
 def _planar_angle(A, b):
     return np.arctan2(A[b, 1, 0], A[b, 0, 0])
 
@@ -298,7 +298,7 @@ def planar_angle_driver(t, q, v, r, A, rd, w, lay, fd, ix, row0, flags, phi, G, 
     return OK
 
 
-@_inline
+@_internal
 def _dot(a0, a1, a2, b0, b1, b2):
     return a0 * b0 + a1 * b1 + a2 * b2
 
@@ -458,7 +458,7 @@ def spring_dampers(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
 # --- exact Jacobian of a point-pair force F(d, ḋ) ---------------------------------------------
 
 
-@_inline
+@_internal
 def _idx6(b, c, nb, dim):
     """Model velocity index of component c (0..5: translation, body-frame rotation) of body b, or −1."""
     if b >= nb:
@@ -472,7 +472,7 @@ def _idx6(b, c, nb, dim):
     return -1
 
 
-@_inline
+@_internal
 def _point_jac(A, b, s0, s1, s2, J):
     """``J_P = [I, C(s̄)]`` (3×6) with ``C(s̄) = −A s̄~`` into J."""
     for i in range(3):
@@ -487,7 +487,7 @@ def _point_jac(A, b, s0, s1, s2, J):
         J[i, 5] = -(a0 * s1 - a1 * s0)
 
 
-@_inline
+@_internal
 def _vel_transport(A, w, b, s0, s1, s2, Vt):
     """``∂ṙ_P/∂θ̄ = −A [ω̄ × s̄]~`` (3×3) into columns 3..5 of Vt (translation columns zero)."""
     c0, c1, c2 = V.cross(w[b, 0], w[b, 1], w[b, 2], s0, s1, s2)
@@ -751,7 +751,7 @@ def compile_spring_dampers(kind, layout) -> CompiledForces:
 # :func:`core.compiled.dynamics.force_jacobian` (the numpy kinds have exact ones).
 
 
-@_inline
+@_internal
 def _dot1_coordinate(A, bi, u0, u1, u2, bj, w0, w1, w2):
     """``x = (A_i ū)ᵀ(A_j w̄)`` and its rotational gradient blocks ``c_i, c_j`` (no translation part)."""
     a0, a1, a2 = V.Av(A, bi, u0, u1, u2)
@@ -761,14 +761,14 @@ def _dot1_coordinate(A, bi, u0, u1, u2, bj, w0, w1, w2):
     return a0 * b0 + a1 * b1 + a2 * b2, ci0, ci1, ci2, cj0, cj1, cj2
 
 
-@_inline
+@_internal
 def _rotation_rate(w, bi, bj, ci0, ci1, ci2, cj0, cj1, cj2):
     """``ẋ = c_i·ω̄_i + c_j·ω̄_j`` of a coordinate with rotational gradient blocks only."""
     return (ci0 * w[bi, 0] + ci1 * w[bi, 1] + ci2 * w[bi, 2]
             + cj0 * w[bj, 0] + cj1 * w[bj, 1] + cj2 * w[bj, 2])
 
 
-@_inline
+@_internal
 def _wrap(x):
     return np.arctan2(np.sin(x), np.cos(x))
 
@@ -816,7 +816,7 @@ def compile_rotational_spring_dampers(kind, layout) -> CompiledForces:
                           names=list(kind.names), what="rotational spring-damper")
 
 
-@_inline
+@_internal
 def _bushing_rotation(A, fd, e, bi, bj, a, b):
     """``R_ab = (A_i m̄_i,a)ᵀ(A_j m̄_j,b)`` (marker axes a of i and b of j) with its gradient blocks."""
     return _dot1_coordinate(A, bi, fd[e, 6 + a], fd[e, 9 + a], fd[e, 12 + a],

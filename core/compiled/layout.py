@@ -59,6 +59,7 @@ from __future__ import annotations
 
 import weakref
 
+import numba
 import numpy as np
 import scipy.sparse as sp
 from numba.core import types
@@ -152,7 +153,7 @@ class CompiledData(structref.StructRefProxy):
     """
 
     def __new__(cls, *values):
-        obj = structref.StructRefProxy.__new__(cls, *values)
+        obj = _new_compiled_data(*values)
         obj._fields = dict(zip(MODEL_FIELDS + KERNEL_FIELDS, values))
         return obj
 
@@ -164,6 +165,14 @@ class CompiledData(structref.StructRefProxy):
 
 
 structref.define_proxy(CompiledData, CompiledDataType, list(MODEL_FIELDS + KERNEL_FIELDS))
+
+
+@numba.njit(cache=True)
+def _new_compiled_data(*values):
+    """The structref built in compiled code by a function numba caches on disk:
+    ``StructRefProxy.__new__`` compiles an uncached constructor in every process (~1.5 s for this
+    type's ~60 fields, paid before a model's first compiled run)."""
+    return CompiledData(*values)
 
 
 class Layout:

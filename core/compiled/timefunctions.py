@@ -76,7 +76,7 @@ def encode_rows(functions: list[TimeFunction], elements: list[str]) -> np.ndarra
     return out
 
 
-@numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+@numba.njit(cache=True, fastmath=False, boundscheck=False)
 def evaluate(prog, t):
     """``(status, f, ḟ, f̈)`` of the program row ``prog`` at time ``t`` (module docstring)."""
     kind = int(prog[0])
@@ -125,7 +125,7 @@ def evaluate(prog, t):
     return OK, f, d1, d2
 
 
-@numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+@numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 def _cycloidal(h, T, t0, integrated, t):
     """``(OK, f, ḟ, f̈)`` of the cycloidal law or of its time integral (module docstring; the
     formulas of :class:`core.drivers._Cycloidal` and :class:`core.flexible.models._SpinUp`)."""

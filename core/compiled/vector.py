@@ -35,13 +35,13 @@ from __future__ import annotations
 
 import numba
 
-_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+_internal = numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 __all__ = ["Av", "ATv", "cross", "vel", "aq", "uC", "rel_point", "rel_vel", "put_row", "add_point_force",
            "add_body_moment", "add_block", "velocity_offset"]
 
 
-@_inline
+@_internal
 def Av(A, b, x0, x1, x2):
     """``A_b x``."""
     return (A[b, 0, 0] * x0 + A[b, 0, 1] * x1 + A[b, 0, 2] * x2,
@@ -49,7 +49,7 @@ def Av(A, b, x0, x1, x2):
             A[b, 2, 0] * x0 + A[b, 2, 1] * x1 + A[b, 2, 2] * x2)
 
 
-@_inline
+@_internal
 def ATv(A, b, x0, x1, x2):
     """``A_bᵀ x``."""
     return (A[b, 0, 0] * x0 + A[b, 1, 0] * x1 + A[b, 2, 0] * x2,
@@ -57,20 +57,20 @@ def ATv(A, b, x0, x1, x2):
             A[b, 0, 2] * x0 + A[b, 1, 2] * x1 + A[b, 2, 2] * x2)
 
 
-@_inline
+@_internal
 def cross(a0, a1, a2, b0, b1, b2):
     """``a × b``."""
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@_inline
+@_internal
 def vel(A, w, b, s0, s1, s2):
     """``C(s̄) ω_b = A_b (ω̄_b × s̄)`` (velocity of a body-fixed vector)."""
     c0, c1, c2 = cross(w[b, 0], w[b, 1], w[b, 2], s0, s1, s2)
     return Av(A, b, c0, c1, c2)
 
 
-@_inline
+@_internal
 def aq(A, w, b, s0, s1, s2):
     """``a^q(s̄) = A_b (ω̄ × (ω̄ × s̄))``."""
     w0, w1, w2 = w[b, 0], w[b, 1], w[b, 2]
@@ -79,14 +79,14 @@ def aq(A, w, b, s0, s1, s2):
     return Av(A, b, d0, d1, d2)
 
 
-@_inline
+@_internal
 def uC(A, b, s0, s1, s2, u0, u1, u2):
     """``uᵀ C(s̄) = (s̄ × A_bᵀu)ᵀ`` (row of the rotational Jacobian along u)."""
     t0, t1, t2 = ATv(A, b, u0, u1, u2)
     return cross(s0, s1, s2, t0, t1, t2)
 
 
-@_inline
+@_internal
 def rel_point(r, A, bi, p0, p1, p2, bj, q0, q1, q2):
     """``d = r_Q − r_P`` with P = s̄_p on body i, Q = s̄_q on body j."""
     u0, u1, u2 = Av(A, bi, p0, p1, p2)
@@ -94,7 +94,7 @@ def rel_point(r, A, bi, p0, p1, p2, bj, q0, q1, q2):
     return r[bj, 0] + v0 - r[bi, 0] - u0, r[bj, 1] + v1 - r[bi, 1] - u1, r[bj, 2] + v2 - r[bi, 2] - u2
 
 
-@_inline
+@_internal
 def rel_vel(rd, A, w, bi, p0, p1, p2, bj, q0, q1, q2):
     """``ḋ = ṙ_Q − ṙ_P`` (velocities of the same two body-fixed points)."""
     x0, x1, x2 = vel(A, w, bi, p0, p1, p2)
@@ -102,7 +102,7 @@ def rel_vel(rd, A, w, bi, p0, p1, p2, bj, q0, q1, q2):
     return rd[bj, 0] + y0 - rd[bi, 0] - x0, rd[bj, 1] + y1 - rd[bi, 1] - x1, rd[bj, 2] + y2 - rd[bi, 2] - x2
 
 
-@_inline
+@_internal
 def put_row(G, row, sl, dim, t0, t1, t2, c0, c1, c2):
     """Store a Jacobian row block (translation t, rotation c) in the model's velocity layout."""
     if dim == 2:
@@ -118,7 +118,7 @@ def put_row(G, row, sl, dim, t0, t1, t2, c0, c1, c2):
         G[row, sl, 5] = c2
 
 
-@_inline
+@_internal
 def add_point_force(Q, A, b, nb, dim, s0, s1, s2, F0, F1, F2, sign):
     """``Q_b += sign · [F; C(s̄)ᵀ F]`` with ``C(s̄)ᵀF = s̄ × A_bᵀF`` (skips the ground)."""
     if b >= nb:
@@ -139,7 +139,7 @@ def add_point_force(Q, A, b, nb, dim, s0, s1, s2, F0, F1, F2, sign):
         Q[o + 5] += sign * c2
 
 
-@_inline
+@_internal
 def add_body_moment(Q, b, nb, dim, m0, m1, m2, sign):
     """``Q_b`` rotational part ``+= sign · M̄`` (body-frame moment; planar: only ``M̄_z``)."""
     if b >= nb:
@@ -153,7 +153,7 @@ def add_body_moment(Q, b, nb, dim, m0, m1, m2, sign):
         Q[o + 5] += sign * m2
 
 
-@_inline
+@_internal
 def add_block(Q, b, nb, dim, t0, t1, t2, c0, c1, c2, s):
     """``Q_b += s · (t; c)`` in the model's velocity layout (planar: ``(t₀, t₁, c₂)``; skips the ground)."""
     if b >= nb:
@@ -173,7 +173,7 @@ def add_block(Q, b, nb, dim, t0, t1, t2, c0, c1, c2, s):
         Q[o + 5] += s * c2
 
 
-@_inline
+@_internal
 def velocity_offset(b, nb, nvb):
     """First velocity index of body ``b`` (−1 for the ground)."""
     if b >= nb:

@@ -82,7 +82,7 @@ MAX_COMPILED_MODES = MAX_SLOTS - 2
 #: Largest correlation abs(M_ij) / sqrt(M_ii M_jj) between different blocks of M̂₀ taken as zero.
 COUPLING_TOL = 1e-8
 
-_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+_internal = numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 
 # ================================================================================================
@@ -238,7 +238,7 @@ def flexible_nodes(t, q, v, r, A, rd, w, lay, fd, ix, row0, flags, phi, G, nu, g
     return OK
 
 
-@_inline
+@_internal
 def _skew(a0, a1, a2, S):
     S[0, 0], S[0, 1], S[0, 2] = 0.0, -a2, a1
     S[1, 0], S[1, 1], S[1, 2] = a2, 0.0, -a0
@@ -413,7 +413,7 @@ def inertia_records(rows: list[dict]) -> tuple[CompiledMass, CompiledForces]:
 # c = (V̄, ω̄, q₁ω̄ … q_mω̄, q̇_f), D(q_f) maps ν̂ = (V̄, ω̄, q̇_f) to c.
 
 
-@_inline
+@_internal
 def _offsets(m, nc):
     """Offsets of K, D, the Gram matrix and K_G in a row of fd (g at 0, the mass at 3, ∫ρx̄ at 4, S at 7)."""
     o_s = 7
@@ -423,7 +423,7 @@ def _offsets(m, nc):
     return o_k, o_d, o_g, o_g + nc * nc
 
 
-@_inline
+@_internal
 def _dt(x, qe, d, r, m, out):
     """``out = D(q_e)ᵀ x`` (x of length n_c, out of length a + m)."""
     a = d + r
@@ -438,7 +438,7 @@ def _dt(x, qe, d, r, m, out):
         out[a + k] = x[a + m * r + k]
 
 
-@_inline
+@_internal
 def _cross_into(dim, a0, a1, a2, b0, b1, b2, out, o, sign):
     """``out[o:] += sign · a × b`` (planar: the z component into ``out[o]``)."""
     if dim == 2:
@@ -449,7 +449,7 @@ def _cross_into(dim, a0, a1, a2, b0, b1, b2, out, o, sign):
         out[o + 2] += sign * (a0 * b1 - a1 * b0)
 
 
-@_inline
+@_internal
 def _mass_block(fd, e, d, r, m, undeformed, Ab, qf, Mb, wk):
     r"""``Mb`` = the body's mass block in the model's velocity coordinates ``(ṙ, ω̄, q̇_f)``:
     :math:`T_A^T D^T\mathcal M D\, T_A` (``D = D(0)`` for the undeformed inertia).  ``wk``: work
@@ -505,7 +505,7 @@ def _mass_block(fd, e, d, r, m, undeformed, Ab, qf, Mb, wk):
             Mb[j, i] = x
 
 
-@_inline
+@_internal
 def _inertia_rhs(fd, e, d, r, m, undeformed, n_prod, Ab, rdot, om, qf, qfd, rhs, wk):
     r"""The body's generalized forces ``rhs`` (length a + m) in the model's velocity coordinates:
     :math:`T_A^T(F - h)` with the quadratic-velocity vector ``h``, gravity, elastic, damping and
@@ -637,7 +637,7 @@ def _inertia_rhs(fd, e, d, r, m, undeformed, n_prod, Ab, rdot, om, qf, qfd, rhs,
         rhs[i] = Ab[i, 0] * t0 + Ab[i, 1] * t1 + (Ab[i, 2] * t2 if d == 3 else 0.0)
 
 
-@_inline
+@_internal
 def _pair(pp):
     """Indices (i, j) of the p-th product ω_i ω_j in the order xx, xy, xz, yy, yz, zz."""
     if pp < 3:
@@ -647,7 +647,7 @@ def _pair(pp):
     return 2, 2
 
 
-@_inline
+@_internal
 def _body_state(e, ix, q, v, A, rd, w, d, m, Ab, rdot, om, qf, qfd):
     """The frame's rotation, velocity and body-axes angular velocity, modal coordinates and rates
     of body ``e`` copied into the work arrays (``om[0]`` = θ̇ in the plane)."""
@@ -666,7 +666,7 @@ def _body_state(e, ix, q, v, A, rd, w, d, m, Ab, rdot, om, qf, qfd):
         qfd[k] = v[ix[e, 4 + m + k]]
 
 
-@_inline
+@_internal
 def _work(lay, ix):
     """Work arrays of the mass-group kernels, sized for the body with the most modes:
     ``(dim, n_rot, A_b, ṙ, ω̄, q_f, q̇_f, rhs, wk)``."""
@@ -779,7 +779,7 @@ def flexible_inertia_jacobian(t, q, v, r, A, rd, w, lay, fd, ix, state, K, D, er
     return OK
 
 
-@_inline
+@_internal
 def _small_rotation(d, axis, h, R):
     """``R`` = the rotation by ``h`` about body axis ``axis`` (planar: about z)."""
     ax = 2 if d == 2 else axis

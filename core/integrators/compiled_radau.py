@@ -98,6 +98,7 @@ from scipy.sparse.csgraph import reverse_cuthill_mckee
 from ..compiled import dynamics as _d
 from ..compiled import layout as _l
 from ..compiled import protocol as _p
+from ..compiled.cache import notify_if_cold
 from ..errors import InputError, NotCompilable
 from .base import STATUS_FAILED, STATUS_RUNNING, Integrator, register
 from .compiled_rk import (
@@ -117,7 +118,7 @@ from .ggl import E as RADAU_E
 from .index1 import DEFAULT_BAUMGARTE
 
 _jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
-_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+_internal = numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 # counters beyond compiled_rk's layout (steps, rejected, rhs, factorisations, ...)
 C_JAC, C_NEWTON, C_NEWTON_FAIL = 7, 8, 9
@@ -150,7 +151,7 @@ class RadauWork(structref.StructRefProxy):
     from Python its fields read as the same numpy arrays)."""
 
     def __new__(cls, **arrays):
-        obj = structref.StructRefProxy.__new__(cls, *(arrays[f] for f in RADAU_WORK_FIELDS))
+        obj = _new_radau_work(*(arrays[f] for f in RADAU_WORK_FIELDS))
         obj._arrays = arrays
         return obj
 
@@ -162,6 +163,13 @@ class RadauWork(structref.StructRefProxy):
 
 
 structref.define_proxy(RadauWork, RadauWorkType, list(RADAU_WORK_FIELDS))
+
+
+@numba.njit(cache=True)
+def _new_radau_work(*values):
+    """Built in compiled code cached on disk (``StructRefProxy.__new__`` compiles an uncached
+    constructor in every process; see :func:`core.compiled.layout._new_compiled_data`)."""
+    return RadauWork(*values)
 
 
 # ================================================================================================
@@ -236,7 +244,7 @@ def _pack(rw, nv, m):
     rw.band[0], rw.band[1] = kl, ku
 
 
-@_inline
+@_internal
 def _abs2(x):
     """``|x|²`` of a real or complex number (no square root: comparisons only)."""
     return x.real * x.real + x.imag * x.imag
@@ -381,9 +389,9 @@ def _jacobian(cd, states, ws, rw, t, q, v):
                 for j in range(grp_w[g]):
                     Mden[grp_v[g, i], grp_v[g, j]] = Mg[g, i, j]
     if m == 0:
-        _pack(rw, nv, 0)
+        _pack(rw, nv, np.int64(0))
         return _p.OK
-    st = _d.constraints(cd, ws, t, q, v, 0)
+    st = _d.constraints(cd, ws, t, q, v, np.int64(0))  # np.int64: a literal would compile a copy
     if st != _p.OK:
         return st
     Gd, G, r_blk, blk_v0, blk_w = rw.Gd, ws.G, cd.r_blk, cd.blk_v0, cd.blk_w
@@ -425,7 +433,7 @@ C_ = np.ascontiguousarray(RADAU_C)
 E_ = np.ascontiguousarray(RADAU_E)
 
 
-@_inline
+@_internal
 def _rms_scaled(x, scale, rows):
     acc = 0.0
     n = scale.shape[0]
@@ -523,7 +531,7 @@ def _collocation(cd, states, ws, rw, lay, nq, constrained, t, y, h, alpha, beta,
     return 1 if converged else 0, k + 1, rate
 
 
-@_inline
+@_internal
 def _predict_factor(h_abs, h_abs_old, error_norm, error_norm_old):
     if error_norm_old < 0.0 or h_abs_old < 0.0 or error_norm == 0.0:
         multiplier = 1.0
@@ -814,6 +822,7 @@ class CompiledRadau(Integrator):
         self._cd = cm.data
         self._states = cm.initial_states()
         self._ws = _d.make_workspace(cm)
+        notify_if_cold(advance, self.name, "about 35 s, 17 s after a jit-dop853 or jit-rk45")
         self.alpha = self.beta = 0.0
         if self.stabilization == "baumgarte":
             self.alpha = float(o.get("alpha", DEFAULT_BAUMGARTE))

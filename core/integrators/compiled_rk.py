@@ -58,12 +58,13 @@ import scipy.integrate as _si
 from ..compiled import dynamics as _d
 from ..compiled import layout as _l
 from ..compiled import protocol as _p
+from ..compiled.cache import notify_if_cold
 from ..errors import InputError, NotCompilable, NumericalFailure
 from .base import STATUS_FAILED, STATUS_RUNNING, Integrator, register
 from .index1 import DEFAULT_BAUMGARTE
 
 _jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
-_jit_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
+_internal = numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 ERR_RK45, ERR_DOP853 = 0, 1
@@ -80,7 +81,7 @@ STIFF_OFF, STIFF_WARN, STIFF_FAIL = 0, 1, 2
 DEFAULT_STIFFNESS = "warn"
 
 
-@_jit_inline
+@_internal
 def _rhs(cd, states, ws, lay, nq, constrained, t, y, alpha, beta, out, lam, counters):
     """Index-1 right-hand side ``out = (Z v, v̇)``; status code."""
     q = y[:nq]
@@ -93,7 +94,7 @@ def _rhs(cd, states, ws, lay, nq, constrained, t, y, alpha, beta, out, lam, coun
     return st
 
 
-@_jit_inline
+@_internal
 def _rms(e, y, y_new, rtol, atol):
     acc = 0.0
     for i in range(e.shape[0]):
@@ -349,6 +350,7 @@ class CompiledRK(Integrator):
         self._cd = self._cm.data
         self._states = self._cm.initial_states()
         self._ws = _d.make_workspace(self._cm)
+        notify_if_cold(advance, self.name, "about 20 s")
         self.alpha = self.beta = 0.0
         if self.stabilization == "baumgarte":
             self.alpha = float(o.get("alpha", DEFAULT_BAUMGARTE))

@@ -218,6 +218,8 @@ def lankarani_nikravesh_force(penetration, penetration_rate, stiffness, restitut
 
 try:  # optional dependency; module-level kernels so that numba's disk cache finds them
     import numba as _numba
+
+    import core.compiled  # noqa: F401  (keys the disk cache on all compiled sources: core.compiled.cache)
 except ImportError:  # pragma: no cover - numba missing
     _numba = None
 

@@ -23,6 +23,8 @@ import numpy as np
 try:  # optional dependency
     import numba
 
+    import core.compiled  # noqa: F401  (keys the disk cache on all compiled sources: core.compiled.cache)
+
     HAVE_NUMBA = True
 except ImportError:  # pragma: no cover - exercised only without numba
     numba = None

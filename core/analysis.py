@@ -329,7 +329,7 @@ def _kinematic_frames(system, times, q, tol, max_iter):
     """Positions, velocities and accelerations of all frames at once (:func:`kinematic_analysis`,
     Notes); None to fall back to the frame-by-frame path."""
     n_f = len(times)
-    q = system.normalize(q.copy()) if hasattr(system, "normalize") and system.space.dim == 3 else q.copy()
+    q = np.array([system.normalize(qi.copy()) for qi in q]) if system.space.dim == 3 else q.copy()
     if system.n_c != system.n_v:
         return None
     scale = np.maximum(1.0, np.max(np.abs(q), axis=1))

@@ -108,10 +108,33 @@ def test_kinematic_analysis_all_frames_equals_frame_by_frame():
     seq = A.kinematic_analysis(model, times)
     qn = model.coordinate_names
     guess = seq[qn].to_numpy() + 1e-3 * RNG.uniform(-1, 1, (len(times), model.n_q))
+    assert A._kinematic_frames(model, times, guess, 1e-10, 50) is not None  # the batched path ran
     bat = A.kinematic_analysis(model, times, q_guess=guess)
     assert bat.attrs["status"] == "finished"
     # Newton's last step is quadratic: the converged residual is far below tol = 1e-10
     np.testing.assert_allclose(bat.to_numpy(), seq.to_numpy(), atol=1e-9)
+
+
+def test_kinematic_analysis_all_frames_spatial():
+    """The same for a spatial rod driven about a tilted revolute axis (Euler parameters: the
+    guesses are normalised and the Newton steps retracted frame by frame)."""
+    from core.drivers import harmonic
+
+    b = ModelBuilder(3, "driven-rod-3d")
+    b.add_body("rod", 2.0, [0.1, 0.12, 0.02], (0.0, 0.0, -0.4))
+    b.add_revolute("pivot", "ground", "rod", (0.0, 0.0, 0.0), axis=(1.0, 0.3, 0.0))
+    b.add_angle_driver("drive", "pivot", harmonic(0.8, 2.5))
+    model = b.build(assemble=True)
+    times = np.linspace(0.0, 2.0, 41)
+    seq = A.kinematic_analysis(model, times)
+    qn = model.coordinate_names
+    guess = seq[qn].to_numpy() + 1e-3 * RNG.uniform(-1, 1, (len(times), model.n_q))
+    assert A._kinematic_frames(model, times, guess, 1e-10, 50) is not None  # the batched path ran
+    bat = A.kinematic_analysis(model, times, q_guess=guess)
+    assert bat.attrs["status"] == "finished"
+    np.testing.assert_allclose(bat.to_numpy(), seq.to_numpy(), atol=1e-9)
+    fast = A.inverse_dynamics_from_kinematics(model, bat)
+    assert fast.attrs["max_residual"] < 1e-9
 
 
 def test_kinematic_analysis_guess_per_frame_checked():
@@ -126,6 +149,9 @@ def test_batched_inverse_dynamics_equals_frame_by_frame(monkeypatch):
     model = _slider_crank()
     times = np.linspace(0.0, 3.0, 31)
     kin = A.kinematic_analysis(model, times)
+    _, vn, an = A._names(model)
+    assert A._inverse_dynamics_frames(model, times, kin[model.coordinate_names].to_numpy(), kin[vn].to_numpy(),
+                                      kin[an].to_numpy()) is not None  # the batched path runs
     fast = A.inverse_dynamics_from_kinematics(model, kin)
     monkeypatch.setattr(A, "_inverse_dynamics_frames", lambda *args: None)
     slow = A.inverse_dynamics_from_kinematics(model, kin)

@@ -54,6 +54,7 @@ __all__ = ["Workspace", "make_workspace", "body_states", "forces", "constraints"
 
 _jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
 _internal = numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+_inline = numba.njit(cache=True, fastmath=False, boundscheck=False, inline="always")
 
 #: a Cholesky pivot below this fraction of its diagonal entry means numerically dependent rows
 PIVOT_RTOL = 1e-12
@@ -250,18 +251,18 @@ def retract(lay, q, dv):
 # slower on the Schur assembly).
 
 
-@_internal
+@_inline
 def _ffd(cd, k):
     """Data of force kind ``k`` (a C-contiguous view of the flat storage)."""
     return cd.frc_fd[cd.frc_fo[k]:cd.frc_fo[k + 1]].reshape((cd.frc_n[k], cd.frc_fw[k]))
 
 
-@_internal
+@_inline
 def _fix(cd, k):
     return cd.frc_ix[cd.frc_io[k]:cd.frc_io[k + 1]].reshape((cd.frc_n[k], cd.frc_iw[k]))
 
 
-@_internal
+@_inline
 def _fst(cd, states, k):
     return states[cd.st_off[k]:cd.st_off[k + 1]].reshape((cd.st_n[k], cd.st_w[k]))
 
@@ -391,7 +392,7 @@ def _spd_inverse(Mg, Mi, g, n):
     return True
 
 
-@_internal
+@_inline
 def _group_times(Mi, grp_v, g, n, src, dst):
     """``dst[v_g] = M_g⁻¹ src[v_g]`` over the velocity indices ``v_g`` of group ``g``."""
     for i in range(n):
@@ -428,7 +429,7 @@ def accept(cd, states, ws, t, q, v):
 # Schur assembly of the 32-link chain was measured 3× slower.
 
 
-@_internal
+@_inline
 def _minv_times(minv, b, wdt, src, so, dst, do):
     """``dst[do:do+w] = M_b⁻¹ src[so:so+w]``."""
     if wdt == 3:
@@ -445,7 +446,7 @@ def _minv_times(minv, b, wdt, src, so, dst, do):
         dst[do] = minv[b, 0, 0] * src[so]
 
 
-@_internal
+@_inline
 def _minv_times_row(minv, b, wdt, G, X, a, sl):
     """``X[a, sl] = M_b⁻¹ G[a, sl]`` (one Jacobian row block)."""
     if wdt == 3:
@@ -462,7 +463,7 @@ def _minv_times_row(minv, b, wdt, G, X, a, sl):
         X[a, sl, 0] = minv[b, 0, 0] * G[a, sl, 0]
 
 
-@_internal
+@_inline
 def _block_dot(G, a, sa, X, b, sb, wdt):
     """``G[a, sa] · X[b, sb]`` over a block of width ``wdt``."""
     if wdt == 3:
@@ -473,7 +474,7 @@ def _block_dot(G, a, sa, X, b, sb, wdt):
     return G[a, sa, 0] * X[b, sb, 0]
 
 
-@_internal
+@_inline
 def _block_dot_vec(G, a, sl, x, o, wdt):
     """``G[a, sl] · x[o:o+w]``."""
     if wdt == 3:
@@ -484,7 +485,7 @@ def _block_dot_vec(G, a, sl, x, o, wdt):
     return G[a, sl, 0] * x[o]
 
 
-@_internal
+@_inline
 def _block_sub(x, o, X, a, sl, mk, wdt):
     """``x[o:o+w] -= X[a, sl] mk``."""
     if wdt == 3:
@@ -508,10 +509,10 @@ def factor(cd, ws):
                    cd.blk_g, cd.blk_go, cd.grp_w, cd.rg_cnt, cd.rg, ws.Mgi, ws.gx, ws.gy)
 
 
-@_internal
+@_inline
 def _factor(reg, first, r_blk, blk_x, blk_w, minv, pat, ext, rs_cnt, rs, nx, xm, hpat, epat, S, L, G, X, C, W, T,
             piv, blk_g, blk_go, grp_w, rg_cnt, rg, Mgi, gx, gy):
-    """:func:`factor` on arrays (inlined where the caller has loaded them once)."""
+    """:func:`factor` on arrays (inlined into it)."""
     m = reg.shape[0]
     ne = ext.shape[0]
     for k in range(m + ne):
@@ -609,7 +610,7 @@ def _group_row(Mgi, g, n, blk_g, blk_go, rs_cnt, rs, G, X, a, gx, gy):
                 X[a, sl, c] = gy[o + c]
 
 
-@_internal
+@_inline
 def _solve_envelope(L, first, m, b):
     """Solve ``L Lᵀ x = b`` in place with the envelope factor."""
     for i in range(m):
@@ -652,7 +653,7 @@ def _lu_factor(T, n, piv):
     return OK
 
 
-@_internal
+@_inline
 def _lu_solve(T, n, piv, b):
     for k in range(n):
         p = piv[k]
@@ -682,10 +683,10 @@ def saddle_solve(cd, ws, f, g, x, mu):
             cd.grp_w, ws.Mgi)
 
 
-@_internal
+@_inline
 def _saddle(reg, first, blk_v0, blk_w, blk_x, minv, ext, rs_cnt, rs, mass_blocks, nx, G, X, rhs, z, L, C, W, T, piv,
             f, g, x, mu, n_grp, grp_v, grp_w, Mgi):
-    """:func:`saddle_solve` on arrays (inlined where the caller has loaded them once)."""
+    """:func:`saddle_solve` on arrays (inlined into it)."""
     # x_B0 = M_B⁻¹ f_B
     for u in range(mass_blocks.shape[0]):
         b = mass_blocks[u]
@@ -743,7 +744,7 @@ def _saddle(reg, first, blk_v0, blk_w, blk_x, minv, ext, rs_cnt, rs, mass_blocks
                     x[blk_v0[b] + c] = z[blk_x[b] + c]
 
 
-@_internal
+@_inline
 def _row_dot(r_blk, blk_v0, blk_w, G, a, x):
     """``(Φ_q x)_a`` for model row ``a``."""
     acc = 0.0
@@ -789,12 +790,12 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
     st = constraints(cd, ws, t, q, v, flags)
     if st != OK:
         return st
-    reg, first, blk_x, ext, rs_cnt, rs, nx = cd.reg, cd.env_first, cd.blk_x, cd.ext, cd.rs_cnt, cd.rs, cd.n_x
-    G, X, S, L, C, W, T, piv = ws.G, ws.X, ws.S, ws.L, ws.C, ws.W, ws.T, ws.piv
-    st = _factor(reg, first, r_blk, blk_x, blk_w, minv, cd.pat, ext, rs_cnt, rs, nx, cd.xm, cd.hpat, cd.epat,
-                 S, L, G, X, C, W, T, piv, cd.blk_g, cd.blk_go, cd.grp_w, cd.rg_cnt, cd.rg, ws.Mgi, ws.gx, ws.gy)
+    # factor and saddle_solve take the two structrefs: a call that passed their ~30 arrays one by one
+    # cost more than the small chain's whole right-hand side (numba counts references per array)
+    st = factor(cd, ws)
     if st != OK:
         return st
+    G = ws.G
     g, gam, nu, phi, mu = ws.g, ws.gam, ws.nu, ws.phi, ws.mu
     for k in range(m):
         a = act[k]
@@ -802,8 +803,7 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
         if baum:
             ga -= 2.0 * alpha * (_row_dot(r_blk, blk_v0, blk_w, G, a, v) - nu[a]) + beta * beta * phi[a]
         g[a] = ga
-    _saddle(reg, first, blk_v0, blk_w, blk_x, minv, ext, rs_cnt, rs, cd.mass_blocks, nx, G, X, ws.rhs, ws.z, L, C, W,
-            T, piv, Q, g, vdot, mu, cd.n_grp, cd.grp_v, cd.grp_w, ws.Mgi)
+    saddle_solve(cd, ws, Q, g, vdot, mu)
     for k in range(m):
         lam[k] = mu[act[k]]
     for i in range(vdot.shape[0]):
@@ -812,7 +812,7 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
     return OK
 
 
-@_internal
+@_inline
 def _max_abs_phi(act, phi):
     mx = 0.0
     for k in range(act.shape[0]):

@@ -371,9 +371,9 @@ class _DrivenPlanarJoints(UserConstraint):
     """All joints of the model as one constraint kind (3 rows per joint, vectorised over joints).
 
     The same equations as :class:`_DrivenPlanarJoint` (module docstring), evaluated for every
-    joint in one numpy call: a Python constraint per joint costs its call overhead in every Newton
-    iteration of core's kinematic analysis; the functions of the coordinates are evaluated once per
-    time (cached by each joint).
+    joint and every frame in one numpy call (a Python constraint per joint costs its call overhead
+    in every Newton iteration of core's kinematic analysis); one time is one frame.  The functions
+    of the coordinates are evaluated once per array of times.
     """
 
     name = "driven joints"
@@ -393,35 +393,7 @@ class _DrivenPlanarJoints(UserConstraint):
         self.bP = np.array([j.jt.beta_parent for j in self.joints])
         self.bC = np.array([j.jt.beta_child for j in self.joints])
         self.has_parent = self.P >= 0
-        self._t_cached, self._cached = None, None
         self._tf = None  # (times, terms) of _time_terms_frames
-
-    def _time_terms(self, t):
-        """Per joint: φ, t(q), R_F-free parts of ν and γ (module docstring), cached per time."""
-        if t != self._t_cached:
-            n = len(self.joints)
-            PH, TQ, V1, W1, A2, G2 = np.zeros(n), np.zeros((n, 2)), np.zeros((n, 2)), np.zeros(n), np.zeros((n, 2)), np.zeros(n)
-            for k, j in enumerate(self.joints):
-                qm, qd, qdd, ph, ph1, ph2, tq, t1, t2 = j._q(t)
-                PH[k], TQ[k] = ph, tq
-                if j.jt.coordinates:
-                    V1[k], W1[k] = t1 @ qd, ph1 @ qd
-                    A2[k], G2[k] = t2 @ (qd * qd) + t1 @ qdd, ph2 @ (qd * qd) + ph1 @ qdd
-            self._cached = (PH, TQ, V1, W1, A2, G2)
-            self._t_cached = t
-        return self._cached
-
-    def _poses(self, q, v=None):
-        x = q[self.q_index].reshape(-1, 3)
-        hp = self.has_parent
-        Pi = np.where(hp, self.P, 0)
-        rP = np.where(hp[:, None], x[Pi, :2], 0.0)
-        thP = np.where(hp, x[Pi, 2], 0.0)
-        rC, thC = x[self.C, :2], x[self.C, 2]
-        if v is None:
-            return rP, thP, rC, thC
-        w = v[self.v_index].reshape(-1, 3)[:, 2]
-        return rP, thP, rC, thC, np.where(hp, w[Pi], 0.0), w[self.C]
 
     @staticmethod
     def _rot(th, u):
@@ -519,50 +491,20 @@ class _DrivenPlanarJoints(UserConstraint):
              + 2.0 * wP[:, :, None] * self._drot(thF, V1) + self._rot(thF, A2))
         return np.concatenate([g, G2[:, :, None]], axis=2).reshape(len(t), -1)
 
+    # one time is one frame (the terms of a time stay cached for the Newton iterations, ν and γ
+    # at that time)
     def phi(self, t, q):
-        PH, TQ, *_ = self._time_terms(t)
-        rP, thP, rC, thC = self._poses(q)
-        thF = thP + self.bP
-        pos = rC + self._rot(thC, self.sC) - rP - self._rot(thP, self.sP) - self._rot(thF, TQ)
-        ang = thC + self.bC - thP - self.bP - PH
-        return np.column_stack([pos, ang]).ravel()
+        return self.phi_frames(np.array([float(t)]), np.asarray(q, float)[None, :])[0]
 
     def jacobian(self, t, q):
-        PH, TQ, *_ = self._time_terms(t)
-        rP, thP, rC, thC = self._poses(q)
-        thF = thP + self.bP
-        n = len(self.joints)
-        J = np.zeros((3 * n, 3 * len(self.bodies)))
-        r0 = 3 * np.arange(n)
-        c0 = 3 * self.C
-        J[r0, c0] = 1.0
-        J[r0 + 1, c0 + 1] = 1.0
-        dC = self._drot(thC, self.sC)
-        J[r0, c0 + 2] = dC[:, 0]
-        J[r0 + 1, c0 + 2] = dC[:, 1]
-        J[r0 + 2, c0 + 2] = 1.0
-        k = np.nonzero(self.has_parent)[0]
-        p0 = 3 * self.P[k]
-        dP = -self._drot(thP[k], self.sP[k]) - self._drot(thF[k], TQ[k])
-        J[r0[k], p0] = -1.0
-        J[r0[k] + 1, p0 + 1] = -1.0
-        J[r0[k], p0 + 2] = dP[:, 0]
-        J[r0[k] + 1, p0 + 2] = dP[:, 1]
-        J[r0[k] + 2, p0 + 2] = -1.0
-        return J
+        return self.jacobian_frames(np.array([float(t)]), np.asarray(q, float)[None, :])[0]
 
     def nu(self, t, q):
-        _, _, V1, W1, _, _ = self._time_terms(t)
-        rP, thP, rC, thC = self._poses(q)
-        return np.column_stack([self._rot(thP + self.bP, V1), W1]).ravel()
+        return self.nu_frames(np.array([float(t)]), np.asarray(q, float)[None, :])[0]
 
     def gamma(self, t, q, v):
-        _, TQ, V1, _, A2, G2 = self._time_terms(t)
-        rP, thP, rC, thC, wP, wC = self._poses(q, v)
-        thF = thP + self.bP
-        g = (wC[:, None] ** 2 * self._rot(thC, self.sC) - wP[:, None] ** 2 * self._rot(thP, self.sP)
-             - wP[:, None] ** 2 * self._rot(thF, TQ) + 2.0 * wP[:, None] * self._drot(thF, V1) + self._rot(thF, A2))
-        return np.column_stack([g, G2]).ravel()
+        return self.gamma_frames(np.array([float(t)]), np.asarray(q, float)[None, :],
+                                 np.asarray(v, float)[None, :])[0]
 
 
 class SagittalModel:

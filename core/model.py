@@ -1286,30 +1286,10 @@ class Model(ConstrainedSystem):
         point P: ``M_P = M_cm − (r_P − r_cm) × F``.
         """
         J = self.Phi_q(t, q)
-        if sp.issparse(J):  # dense rows: per-joint sparse slicing cost ~0.1 ms a joint
-            J = J.toarray()
-        groups = self.reaction_groups()
-        bs = self.body_states(q, None)
-        d, nvb = self.space.dim, self.space.n_v
-        out = {}
-        for name, (kb, sloc) in self._reaction_points.items():
-            rows = groups.get(name)
-            if rows is None or len(rows) == 0 or kb >= self.n_bodies:
-                continue
-            cols = slice(kb * nvb, (kb + 1) * nvb)
-            Qc = -(J[rows][:, cols].T @ lam[rows])
-            Qc = np.asarray(Qc).ravel()
-            F = Qc[:d]
-            arm = bs.A[kb] @ sloc
-            if d == 2:
-                Mcm = Qc[2]
-                Mp = Mcm - (arm[0] * F[1] - arm[1] * F[0])
-                out[name] = np.array([F[0], F[1], Mp])
-            else:
-                Mcm = bs.A[kb] @ Qc[3:]
-                Mp = Mcm - np.cross(arm, F)
-                out[name] = np.concatenate([F, Mp])
-        return out
+        J = J.toarray() if sp.issparse(J) else np.asarray(J, float)  # dense rows: sparse slicing ~0.1 ms a joint
+        q = np.asarray(q, float)
+        out = self.reactions_frames([t], q[None, :], np.asarray(lam, float)[None, :], J=J[None])
+        return {name: val[0] for name, val in out.items()}
 
     # --- build-time checks -------------------------------------------------------------------
     def _check_initial(self, tol: float) -> None:

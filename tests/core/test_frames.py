@@ -79,6 +79,9 @@ def test_constraint_terms_and_reactions_frames_equal_single_frames(dim):
         np.testing.assert_allclose(J[i], J1.toarray(), atol=1e-14)
         np.testing.assert_allclose(nu[i], n1, atol=1e-14)
         np.testing.assert_allclose(ga[i], g1, atol=1e-13)
+        # reactions() is reactions_frames() of one frame: this compares the batched Φ_q it is given
+        # with the per-frame one; the reactions themselves are checked against closed forms in
+        # test_analysis.py (driver moment of the compound pendulum)
         for name, val in model.reactions(t, q[i], lam[i]).items():
             np.testing.assert_allclose(R[name][i], val, rtol=1e-12, atol=1e-13)
     assert not model.frames_vectorised  # joint kinds: evaluated frame by frame
@@ -100,19 +103,22 @@ def _slider_crank():
     return b.build(assemble=True)
 
 
-def test_kinematic_analysis_all_frames_equals_frame_by_frame():
-    """A guess per frame (the sequential solution perturbed by 1 mm / 1 mrad) gives the same
-    positions, velocities and accelerations as the sequential analysis, to its tolerance."""
-    model = _slider_crank()
-    times = np.linspace(0.0, np.pi, 37)  # a full revolution at 2 rad/s
+def _batched_equals_sequential(model, times):
+    """A guess per frame (the sequential solution perturbed by 1 mm / 1 mrad) takes the batched
+    path and gives the sequential analysis's positions, velocities and accelerations; returns the
+    batched table."""
     seq = A.kinematic_analysis(model, times)
-    qn = model.coordinate_names
-    guess = seq[qn].to_numpy() + 1e-3 * RNG.uniform(-1, 1, (len(times), model.n_q))
+    guess = seq[model.coordinate_names].to_numpy() + 1e-3 * RNG.uniform(-1, 1, (len(times), model.n_q))
     assert A._kinematic_frames(model, times, guess, 1e-10, 50) is not None  # the batched path ran
     bat = A.kinematic_analysis(model, times, q_guess=guess)
     assert bat.attrs["status"] == "finished"
     # Newton's last step is quadratic: the converged residual is far below tol = 1e-10
     np.testing.assert_allclose(bat.to_numpy(), seq.to_numpy(), atol=1e-9)
+    return bat
+
+
+def test_kinematic_analysis_all_frames_equals_frame_by_frame():
+    _batched_equals_sequential(_slider_crank(), np.linspace(0.0, np.pi, 37))  # a revolution at 2 rad/s
 
 
 def test_kinematic_analysis_all_frames_spatial():
@@ -125,14 +131,7 @@ def test_kinematic_analysis_all_frames_spatial():
     b.add_revolute("pivot", "ground", "rod", (0.0, 0.0, 0.0), axis=(1.0, 0.3, 0.0))
     b.add_angle_driver("drive", "pivot", harmonic(0.8, 2.5))
     model = b.build(assemble=True)
-    times = np.linspace(0.0, 2.0, 41)
-    seq = A.kinematic_analysis(model, times)
-    qn = model.coordinate_names
-    guess = seq[qn].to_numpy() + 1e-3 * RNG.uniform(-1, 1, (len(times), model.n_q))
-    assert A._kinematic_frames(model, times, guess, 1e-10, 50) is not None  # the batched path ran
-    bat = A.kinematic_analysis(model, times, q_guess=guess)
-    assert bat.attrs["status"] == "finished"
-    np.testing.assert_allclose(bat.to_numpy(), seq.to_numpy(), atol=1e-9)
+    bat = _batched_equals_sequential(model, np.linspace(0.0, 2.0, 41))
     fast = A.inverse_dynamics_from_kinematics(model, bat)
     assert fast.attrs["max_residual"] < 1e-9
 

@@ -88,6 +88,11 @@ def main(argv=None) -> int:
     p.add_argument("--new", default=str(HERE.parent), help="checkout of the new version (default: this one)")
     p.add_argument("--rounds", type=int, default=4)
     args = p.parse_args(argv)
+    if args.rounds < 1:
+        p.error(f"--rounds must be >= 1, got {args.rounds}")
+    for opt in ("old", "new"):
+        if not (Path(getattr(args, opt)) / "core").is_dir():
+            p.error(f"--{opt} {getattr(args, opt)!r} is not a checkout of mbsuite (no core/ folder in it)")
     sides = {"old": Path(args.old).resolve(), "new": Path(args.new).resolve()}
     caches = {k: Path(tempfile.mkdtemp(prefix=f"mbsuite-ab-{k}-")) for k in sides}
     runs = {k: [] for k in sides}

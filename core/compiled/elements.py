@@ -422,8 +422,10 @@ def point_springs(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
         d0, d1, d2 = V.rel_point(r, A, bi, p0, p1, p2, bj, q0, q1, q2)
         dd0, dd1, dd2 = V.rel_vel(rd, A, w, bi, p0, p1, p2, bj, q0, q1, q2)
         F0, F1, F2 = k * d0 + c * dd0, k * d1 + c * dd1, k * d2 + c * dd2
-        V.add_point_force(Q, A, bi, nb, dim, p0, p1, p2, F0, F1, F2, 1.0)
-        V.add_point_force(Q, A, bj, nb, dim, q0, q1, q2, F0, F1, F2, -1.0)
+        if bi < nb:
+            V.add_point_force(Q, A, bi, dim, p0, p1, p2, F0, F1, F2, 1.0)
+        if bj < nb:
+            V.add_point_force(Q, A, bj, dim, q0, q1, q2, F0, F1, F2, -1.0)
     return OK
 
 
@@ -450,8 +452,10 @@ def spring_dampers(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
                 return st
         f = (fd[e, 6] * (L - fd[e, 8]) + fd[e, 7] * Ld + fa) / L
         F0, F1, F2 = f * d0, f * d1, f * d2
-        V.add_point_force(Q, A, bi, nb, dim, p0, p1, p2, F0, F1, F2, 1.0)
-        V.add_point_force(Q, A, bj, nb, dim, q0, q1, q2, F0, F1, F2, -1.0)
+        if bi < nb:
+            V.add_point_force(Q, A, bi, dim, p0, p1, p2, F0, F1, F2, 1.0)
+        if bj < nb:
+            V.add_point_force(Q, A, bj, dim, q0, q1, q2, F0, F1, F2, -1.0)
     return OK
 
 
@@ -658,7 +662,8 @@ def applied_forces(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
             F0, F1, F2 = V.Av(A, b, F[0], F[1], F[2])
         else:
             F0, F1, F2 = F[0], F[1], F[2]
-        V.add_point_force(Q, A, b, nb, dim, fd[e, 0], fd[e, 1], fd[e, 2], F0, F1, F2, 1.0)
+        if b < nb:
+            V.add_point_force(Q, A, b, dim, fd[e, 0], fd[e, 1], fd[e, 2], F0, F1, F2, 1.0)
     return OK
 
 
@@ -682,7 +687,8 @@ def applied_torques(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
             m0, m1, m2 = V.ATv(A, b, T[0], T[1], T[2])
         else:
             m0, m1, m2 = T[0], T[1], T[2]
-        V.add_body_moment(Q, b, nb, dim, m0, m1, m2, 1.0)
+        if b < nb:
+            V.add_body_moment(Q, b, dim, m0, m1, m2, 1.0)
     return OK
 
 
@@ -799,8 +805,10 @@ def rotational_spring_dampers(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
                 err[1] = e
                 return st
         T = fd[e, 9] * _wrap(np.arctan2(a, b) - fd[e, 11]) + fd[e, 10] * thd + ta
-        V.add_block(Q, bi, nb, dim, 0.0, 0.0, 0.0, gi0, gi1, gi2, -T)
-        V.add_block(Q, bj, nb, dim, 0.0, 0.0, 0.0, gj0, gj1, gj2, -T)
+        if bi < nb:
+            V.add_block(Q, bi, dim, 0.0, 0.0, 0.0, gi0, gi1, gi2, -T)
+        if bj < nb:
+            V.add_block(Q, bj, dim, 0.0, 0.0, 0.0, gj0, gj1, gj2, -T)
     return OK
 
 
@@ -847,8 +855,10 @@ def bushings(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
             xd = (-a0 * rd[bi, 0] - a1 * rd[bi, 1] - a2 * rd[bi, 2] + a0 * rd[bj, 0] + a1 * rd[bj, 1]
                   + a2 * rd[bj, 2] + _rotation_rate(w, bi, bj, ci0, ci1, ci2, cj0, cj1, cj2))
             f = fd[e, 24 + k] * (x - fd[e, 36 + k]) + fd[e, 30 + k] * xd
-            V.add_block(Q, bi, nb, dim, -a0, -a1, -a2, ci0, ci1, ci2, -f)
-            V.add_block(Q, bj, nb, dim, a0, a1, a2, cj0, cj1, cj2, -f)
+            if bi < nb:
+                V.add_block(Q, bi, dim, -a0, -a1, -a2, ci0, ci1, ci2, -f)
+            if bj < nb:
+                V.add_block(Q, bj, dim, a0, a1, a2, cj0, cj1, cj2, -f)
         if dim == 2:
             ra, ai0, ai1, ai2, aj0, aj1, aj2 = _bushing_rotation(A, fd, e, bi, bj, 1, 0)
             rb, bi0, bi1, bi2, bj0, bj1, bj2 = _bushing_rotation(A, fd, e, bi, bj, 0, 0)
@@ -860,8 +870,10 @@ def bushings(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
             cj2 = (rb * aj2 - ra * bj2) / rho2
             xd = ci2 * w[bi, 2] + cj2 * w[bj, 2]
             f = fd[e, 26] * _wrap(np.arctan2(ra, rb) - fd[e, 38]) + fd[e, 32] * xd
-            V.add_block(Q, bi, nb, dim, 0.0, 0.0, 0.0, 0.0, 0.0, ci2, -f)
-            V.add_block(Q, bj, nb, dim, 0.0, 0.0, 0.0, 0.0, 0.0, cj2, -f)
+            if bi < nb:
+                V.add_block(Q, bi, dim, 0.0, 0.0, 0.0, 0.0, 0.0, ci2, -f)
+            if bj < nb:
+                V.add_block(Q, bj, dim, 0.0, 0.0, 0.0, 0.0, 0.0, cj2, -f)
         else:
             for k in range(3):  # Δ_r,k = ½ (R[k2, k1] − R[k1, k2]) with (k1, k2) cyclic after k
                 k1 = (k + 1) % 3
@@ -873,8 +885,10 @@ def bushings(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
                 cj0, cj1, cj2 = 0.5 * (pj0 - qj0), 0.5 * (pj1 - qj1), 0.5 * (pj2 - qj2)
                 xd = _rotation_rate(w, bi, bj, ci0, ci1, ci2, cj0, cj1, cj2)
                 f = fd[e, 27 + k] * (x - fd[e, 39 + k]) + fd[e, 33 + k] * xd
-                V.add_block(Q, bi, nb, dim, 0.0, 0.0, 0.0, ci0, ci1, ci2, -f)
-                V.add_block(Q, bj, nb, dim, 0.0, 0.0, 0.0, cj0, cj1, cj2, -f)
+                if bi < nb:
+                    V.add_block(Q, bi, dim, 0.0, 0.0, 0.0, ci0, ci1, ci2, -f)
+                if bj < nb:
+                    V.add_block(Q, bj, dim, 0.0, 0.0, 0.0, cj0, cj1, cj2, -f)
     return OK
 
 
@@ -942,8 +956,10 @@ def bump_stops(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
             ud = (-a0 * rd[bi, 0] - a1 * rd[bi, 1] - a2 * rd[bi, 2] + a0 * rd[bj, 0] + a1 * rd[bj, 1]
                   + a2 * rd[bj, 2] + _rotation_rate(w, bi, bj, ci0, ci1, ci2, cj0, cj1, cj2))
             f += fd[e, 10] * ud
-        V.add_block(Q, bi, nb, dim, -a0, -a1, -a2, ci0, ci1, ci2, -f)
-        V.add_block(Q, bj, nb, dim, a0, a1, a2, cj0, cj1, cj2, -f)
+        if bi < nb:
+            V.add_block(Q, bi, dim, -a0, -a1, -a2, ci0, ci1, ci2, -f)
+        if bj < nb:
+            V.add_block(Q, bj, dim, a0, a1, a2, cj0, cj1, cj2, -f)
     return OK
 
 
@@ -977,8 +993,10 @@ def series_spring_dampers(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
             return COINCIDENT
         Fs = fd[e, 6] * (L - q[xq] - fd[e, 8])
         f = Fs / L
-        V.add_point_force(Q, A, bi, nb, dim, p0, p1, p2, f * d0, f * d1, f * d2, 1.0)
-        V.add_point_force(Q, A, bj, nb, dim, q0, q1, q2, f * d0, f * d1, f * d2, -1.0)
+        if bi < nb:
+            V.add_point_force(Q, A, bi, dim, p0, p1, p2, f * d0, f * d1, f * d2, 1.0)
+        if bj < nb:
+            V.add_point_force(Q, A, bj, dim, q0, q1, q2, f * d0, f * d1, f * d2, -1.0)
         Q[xv] += Fs - fd[e, 7] * v[xv]
     return OK
 
@@ -1066,7 +1084,8 @@ def plane_contacts(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
         Fn = K * delta ** p * (1.0 + chi * ddelta / v0)
         if not Fn > 0.0:
             continue
-        V.add_point_force(Q, A, b, nb, dim, s0, s1, s2, Fn * n0, Fn * n1, Fn * n2, 1.0)
+        if b < nb:
+            V.add_point_force(Q, A, b, dim, s0, s1, s2, Fn * n0, Fn * n1, Fn * n2, 1.0)
         if mu > 0.0:
             # contact point r_C − R n in body coordinates: s̄ − R Aᵀn
             m0, m1, m2 = V.ATv(A, b, n0, n1, n2)
@@ -1076,7 +1095,8 @@ def plane_contacts(t, q, v, r, A, rd, w, lay, fd, ix, state, Q, err):
             vn = vc0 * n0 + vc1 * n1 + vc2 * n2
             vt0, vt1, vt2 = vc0 - vn * n0, vc1 - vn * n1, vc2 - vn * n2
             g = mu * Fn / np.sqrt(vt0 * vt0 + vt1 * vt1 + vt2 * vt2 + ve * ve)
-            V.add_point_force(Q, A, b, nb, dim, t0, t1, t2, -g * vt0, -g * vt1, -g * vt2, 1.0)
+            if b < nb:
+                V.add_point_force(Q, A, b, dim, t0, t1, t2, -g * vt0, -g * vt1, -g * vt2, 1.0)
     return OK
 
 

@@ -1,4 +1,4 @@
-r"""Scalar 3-vector kinematics for writing kernels (inlined into the caller; no arrays allocated).
+r"""Scalar 3-vector kinematics for writing kernels (each compiled once, called by the kernels; no allocation).
 
 Body states are in three-dimensional form (see :mod:`core.compiled.protocol`); for a body ``b``
 and a body-fixed vector ``s̄`` (Nikravesh 1988, Eqs. 6.151–6.156):
@@ -26,8 +26,8 @@ function                                          returns
 The three ``add_*`` functions take a body, never the ground (``b < nb``): the caller tests
 ``if b < nb:`` before the call.  A test inside the function costs, measured, about 25 ns per call
 (numba keeps the reference-count updates of ``Q`` and ``A`` around a conditional exit of the
-callee), more than the force itself: a kernel of eight point springs took 0.57 µs with the
-test inside and 0.09 µs with it in the caller (2-core Intel Xeon, issue 24).
+callee), more than the force itself: the kernel of eight point springs took 0.60 µs with the
+test inside and 0.14–0.20 µs with it in the caller (2-core Intel Xeon, issue 24).
 
 Planar bodies rotate about z, so ``C(s̄) ω = A(ω × s̄)`` and ``a^q = A(ω × (ω × s̄))`` reproduce
 the planar ``A R s̄ θ̇`` and ``−A s̄ θ̇²`` exactly: one kernel serves planar and spatial models.

@@ -42,10 +42,15 @@ from core.integrators import simulate
 from core.models import n_link_chain
 out = {}
 def best(f, n):
-    f()
+    """Best time of n runs after a warm-up; a run that did not finish is an error, not a time."""
+    def checked():
+        res = f()
+        if res.status != "finished":
+            raise RuntimeError(f"a timed run ended with status {res.status!r}: {getattr(res, 'message', '')}")
+    checked()
     b = 1e9
     for _ in range(n):
-        t0 = time.perf_counter(); f(); b = min(b, time.perf_counter() - t0)
+        t0 = time.perf_counter(); checked(); b = min(b, time.perf_counter() - t0)
     return b
 m8, s8 = n_link_chain(8), n_link_chain(8, stiff_k=1e6)
 kw = dict(t_eval=[0.0, 1.0], compute_multipliers=False)

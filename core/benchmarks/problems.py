@@ -395,7 +395,7 @@ def _a04_error(system, q, v, ref) -> float:
 #: Baumgarte index-1 variants (their projected counterparts stay) and LSODA (it restarts
 #: after every projection, see core.integrators.index1).  Patterns, so integrators registered
 #: later are included by default.
-_STD_EXCLUDE = ("rk45", "dop853", "radau", "bdf", "lsoda*", "*-baumgarte", "jit-rk45", "jit-dop853")
+_STD_EXCLUDE = ("rk45", "dop853", "radau", "bdf", "lsoda*", "*-baumgarte", "jit-rk45", "jit-dop853", "jit-rk4")
 #: For unconstrained (stiff spring) problems projection and Baumgarte change nothing.
 _ODE_EXCLUDE = ("*-projection", "*-baumgarte", "lsoda*")
 _QUICK_METHODS = ("rk45-projection", "dop853-projection", "jit-dop853-projection", "radau-projection",

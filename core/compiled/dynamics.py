@@ -46,7 +46,27 @@ import numpy as np
 from numba.core import types
 from numba.experimental import structref
 
-from .protocol import MASS_NOT_PD, MAX_SLOTS, NONFINITE, OK, SINGULAR, WANT_GAMMA, WANT_NU, WANT_PHI
+from .protocol import (
+    FT_FD0,
+    FT_FD1,
+    FT_FW,
+    FT_IW,
+    FT_IX0,
+    FT_IX1,
+    FT_N,
+    FT_ST0,
+    FT_ST1,
+    FT_STN,
+    FT_STW,
+    MASS_NOT_PD,
+    MAX_SLOTS,
+    NONFINITE,
+    OK,
+    SINGULAR,
+    WANT_GAMMA,
+    WANT_NU,
+    WANT_PHI,
+)
 
 __all__ = ["Workspace", "make_workspace", "body_states", "forces", "constraints", "factor", "saddle_solve",
            "accelerations", "project", "accept", "force_jacobian", "qdot", "retract", "normalize", "mass_update", "PIVOT_RTOL",
@@ -145,8 +165,13 @@ def body_states(lay, q, v, ws):
     Planar bodies are embedded as rotations about z: ``A = [[c, −s, 0], [s, c, 0], [0, 0, 1]]``,
     ``ω̄ = (0, 0, θ̇)``.  Spatial: ``A(p)`` of the Euler parameters (Nikravesh 1988, Eq. 6.19).
     """
+    _body_states(lay, q, v, ws.r, ws.A, ws.rd, ws.w)
+
+
+@_inline
+def _body_states(lay, q, v, r, A, rd, w):
+    """:func:`body_states` on the arrays themselves (read from the workspace once by the caller)."""
     nb, dim = lay[0], lay[1]
-    r, A, rd, w = ws.r, ws.A, ws.rd, ws.w
     if dim == 2:
         for b in range(nb):
             th = q[3 * b + 2]
@@ -248,34 +273,45 @@ def retract(lay, q, dv):
 
 # Compiled code reads the fields of the model and workspace tuples into locals once per call:
 # reading a tuple field inside a loop reference-counts the array on every access (measured 15×
-# slower on the Schur assembly).
+# slower on the Schur assembly).  Every read of a structure's array, and every view, is one atomic
+# increment and decrement (~10 ns): the right-hand side reads the body-state arrays once and the
+# force kinds' offsets and shapes from one table (``frc_tab``): the 8-link penalty chain's
+# accelerations 0.69 -> 0.59 µs, the same run.
 
 
 @_inline
 def _ffd(cd, k):
     """Data of force kind ``k`` (a C-contiguous view of the flat storage)."""
-    return cd.frc_fd[cd.frc_fo[k]:cd.frc_fo[k + 1]].reshape((cd.frc_n[k], cd.frc_fw[k]))
+    tab = cd.frc_tab
+    return cd.frc_fd[tab[k, FT_FD0]:tab[k, FT_FD1]].reshape((tab[k, FT_N], tab[k, FT_FW]))
 
 
 @_inline
 def _fix(cd, k):
-    return cd.frc_ix[cd.frc_io[k]:cd.frc_io[k + 1]].reshape((cd.frc_n[k], cd.frc_iw[k]))
+    tab = cd.frc_tab
+    return cd.frc_ix[tab[k, FT_IX0]:tab[k, FT_IX1]].reshape((tab[k, FT_N], tab[k, FT_IW]))
 
 
 @_inline
 def _fst(cd, states, k):
-    return states[cd.st_off[k]:cd.st_off[k + 1]].reshape((cd.st_n[k], cd.st_w[k]))
+    tab = cd.frc_tab
+    return states[tab[k, FT_ST0]:tab[k, FT_ST1]].reshape((tab[k, FT_STN], tab[k, FT_STW]))
 
 
 @_jit
 def forces(cd, states, ws, t, q, v, Q):
     """``Q``: gravity, gyroscopic moments and every force kind (call :func:`body_states` first)."""
+    return _forces(cd, states, t, q, v, ws.r, ws.A, ws.rd, ws.w, ws.err, Q)
+
+
+@_inline
+def _forces(cd, states, t, q, v, r, A, rd, w, err, Q):
+    """:func:`forces` with the workspace's body-state arrays read by the caller."""
     lay = cd.lay
     Qg = cd.Qg
     nb, dim, n_v = lay[0], lay[1], lay[5]
     for i in range(n_v):
         Q[i] = Qg[i]
-    r, A, rd, w, err = ws.r, ws.A, ws.rd, ws.w, ws.err
     if dim == 3:
         J = cd.Jt
         for b in range(nb):
@@ -289,13 +325,12 @@ def forces(cd, states, ws, t, q, v, Q):
     n_frc = cd.n_frc
     if n_frc:
         frc = cd.frc
-        fd, fo, fn, fw = cd.frc_fd, cd.frc_fo, cd.frc_n, cd.frc_fw
-        ix, io, iw = cd.frc_ix, cd.frc_io, cd.frc_iw
-        st_off, st_n, st_w = cd.st_off, cd.st_n, cd.st_w
+        fd, ix, tab = cd.frc_fd, cd.frc_ix, cd.frc_tab
         for k in range(n_frc):
-            st = frc[k](t, q, v, r, A, rd, w, lay, fd[fo[k]:fo[k + 1]].reshape((fn[k], fw[k])),
-                        ix[io[k]:io[k + 1]].reshape((fn[k], iw[k])),
-                        states[st_off[k]:st_off[k + 1]].reshape((st_n[k], st_w[k])), Q, err)
+            n = tab[k, FT_N]
+            st = frc[k](t, q, v, r, A, rd, w, lay, fd[tab[k, FT_FD0]:tab[k, FT_FD1]].reshape((n, tab[k, FT_FW])),
+                        ix[tab[k, FT_IX0]:tab[k, FT_IX1]].reshape((n, tab[k, FT_IW])),
+                        states[tab[k, FT_ST0]:tab[k, FT_ST1]].reshape((tab[k, FT_STN], tab[k, FT_STW])), Q, err)
             if st != OK:
                 err[0] = k
                 err[2] = 1
@@ -761,10 +796,11 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
 
     ``M v̇ + Φ_qᵀλ = Q``, ``Φ_q v̇ = γ − 2α(Φ_q v − ν) − β²Φ``.
     """
-    lay, act, blk_v0, blk_w, minv, r_blk = cd.lay, cd.act, cd.blk_v0, cd.blk_w, cd.minv, cd.r_blk
+    lay, act, blk_v0, blk_w, minv = cd.lay, cd.act, cd.blk_v0, cd.blk_w, cd.minv
     Q = ws.Q
-    body_states(lay, q, v, ws)
-    st = forces(cd, states, ws, t, q, v, Q)
+    r, A, rd, w = ws.r, ws.A, ws.rd, ws.w
+    _body_states(lay, q, v, r, A, rd, w)
+    st = _forces(cd, states, t, q, v, r, A, rd, w, ws.err, Q)
     if st != OK:
         return st
     st = mass_update(cd, ws, t, q, v)
@@ -783,6 +819,7 @@ def accelerations(cd, states, ws, t, q, v, alpha, beta, vdot, lam):
             if not np.isfinite(vdot[i]):
                 return NONFINITE
         return OK
+    r_blk = cd.r_blk
     baum = alpha != 0.0 or beta != 0.0
     flags = WANT_GAMMA
     if baum:

@@ -69,6 +69,18 @@ from scipy.sparse.csgraph import reverse_cuthill_mckee
 from ..errors import NotCompilable
 from .protocol import (
     ACCEPT_SIGNATURE,
+    FRC_TAB_WIDTH,
+    FT_FD0,
+    FT_FD1,
+    FT_FW,
+    FT_IW,
+    FT_IX0,
+    FT_IX1,
+    FT_N,
+    FT_ST0,
+    FT_ST1,
+    FT_STN,
+    FT_STW,
     CONSTRAINT_SIGNATURE,
     FORCE_JACOBIAN_SIGNATURE,
     FORCE_SIGNATURE,
@@ -127,10 +139,13 @@ MODEL_FIELDS = (
 #: ... and the kinds' kernels (tuples of function pointers padded to KIND_CAPACITY with no-ops)
 #: with their data stored flat: kind ``k`` reads ``fd[fo[k]:fo[k+1]].reshape(n[k], fw[k])`` and
 #: ``ix[io[k]:io[k+1]].reshape(n[k], iw[k])``; its search state is
-#: ``states[st_off[k]:st_off[k+1]].reshape(st_n[k], st_w[k])``.
+#: ``states[st_off[k]:st_off[k+1]].reshape(st_n[k], st_w[k])``.  ``frc_tab`` holds the same
+#: offsets and shapes of the force kinds as one int64 table (n_frc, FRC_TAB_WIDTH), columns
+#: ``FT_*``: the right-hand side reads one array for them instead of eight (each read of a
+#: structure's array is counted up and down atomically by numba, ~10 ns a pair).
 KERNEL_FIELDS = (
     "n_con", "con", "con_fd", "con_fo", "con_n", "con_fw", "con_ix", "con_io", "con_iw", "con_row0",
-    "n_frc", "frc", "frc_fd", "frc_fo", "frc_n", "frc_fw", "frc_ix", "frc_io", "frc_iw",
+    "n_frc", "frc", "frc_fd", "frc_fo", "frc_n", "frc_fw", "frc_ix", "frc_io", "frc_iw", "frc_tab",
     "frc_jac", "frc_has_jac", "frc_acc", "frc_stateful", "st_off", "st_n", "st_w",
     "mass_k", "mass_fd", "mass_ix",  # the mass kernel of the groups (a 1-tuple; a no-op without groups) and its data
 )
@@ -753,10 +768,16 @@ def _kernel_tuples(ckinds, fkinds, mass_rec: CompiledMass | None = None) -> tupl
                    res(r.accept, "accept", ACCEPT_SIGNATURE, f"{r.what} {r.names[0]!r}") for r in fkinds], _no_accept)
     frc_stateful = np.array([r.accept is not None for r in fkinds] + [False], np.int64)
     states, st_off, st_n, st_w = _stack([_f2(r.state) if r.state.size else np.zeros((0, 0)) for r in fkinds], float)
+    nk = len(fkinds)
+    frc_tab = np.zeros((max(nk, 1), FRC_TAB_WIDTH), np.int64)
+    for col, vals in ((FT_FD0, frc_fo[:nk]), (FT_FD1, frc_fo[1:nk + 1]), (FT_N, frc_n[:nk]), (FT_FW, frc_fw[:nk]),
+                      (FT_IX0, frc_io[:nk]), (FT_IX1, frc_io[1:nk + 1]), (FT_IW, frc_iw[:nk]),
+                      (FT_ST0, st_off[:nk]), (FT_ST1, st_off[1:nk + 1]), (FT_STN, st_n[:nk]), (FT_STW, st_w[:nk])):
+        frc_tab[:nk, col] = vals
     fields = dict(n_con=len(ckinds), con=con, con_fd=con_fd, con_fo=con_fo, con_n=con_n, con_fw=con_fw,
                   con_ix=con_ix, con_io=con_io, con_iw=con_iw, con_row0=con_row0,
                   n_frc=len(fkinds), frc=frc, frc_fd=frc_fd, frc_fo=frc_fo, frc_n=frc_n, frc_fw=frc_fw,
-                  frc_ix=frc_ix, frc_io=frc_io, frc_iw=frc_iw, frc_jac=frc_jac, frc_has_jac=frc_has_jac,
+                  frc_ix=frc_ix, frc_io=frc_io, frc_iw=frc_iw, frc_tab=frc_tab, frc_jac=frc_jac, frc_has_jac=frc_has_jac,
                   frc_acc=frc_acc, frc_stateful=frc_stateful, st_off=st_off, st_n=st_n, st_w=st_w)
     if mass_rec is None:
         fields.update(mass_k=(_no_mass.dispatcher,), mass_fd=np.zeros((1, 1)), mass_ix=np.zeros((1, 1), np.int64))

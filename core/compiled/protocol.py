@@ -78,6 +78,8 @@ __all__ = [
     "OK", "SINGULAR", "COINCIDENT", "NONFINITE", "PROJECTION", "OUT_OF_RANGE", "ELEMENT_FAILED", "MASS_NOT_PD",
     "STATUS_MESSAGES", "WANT_PHI", "WANT_NU", "WANT_GAMMA", "WANT_ALL", "MAX_SLOTS", "LAYOUT_FIELDS",
     "L_NB", "L_DIM", "L_NQB", "L_NVB", "L_NQ", "L_NV", "L_NX",
+    "FRC_TAB_FIELDS", "FRC_TAB_WIDTH", "FT_FD0", "FT_FD1", "FT_N", "FT_FW", "FT_IX0", "FT_IX1", "FT_IW", "FT_ST0",
+    "FT_ST1", "FT_STN", "FT_STW",
     "FORCE_SIGNATURE", "CONSTRAINT_SIGNATURE", "FORCE_JACOBIAN_SIGNATURE", "ACCEPT_SIGNATURE", "MASS_SIGNATURE",
     "Kernel", "force_kernel", "constraint_kernel", "force_jacobian_kernel", "accept_kernel", "mass_kernel",
     "resolve_kernel", "CompiledForces", "CompiledConstraints", "CompiledMass", "body_slot", "extra_slot",
@@ -117,6 +119,13 @@ MAX_SLOTS = 8
 #: Entries of the layout array ``lay`` passed to every kernel.
 LAYOUT_FIELDS = ("n_bodies", "dim", "n_q_body", "n_v_body", "n_q", "n_v", "n_extra")
 L_NB, L_DIM, L_NQB, L_NVB, L_NQ, L_NV, L_NX = range(len(LAYOUT_FIELDS))
+
+#: Columns of the force kinds' table ``frc_tab`` of the compiled model (one row per kind): the
+#: kind's data ``frc_fd[FD0:FD1].reshape(N, FW)``, indices ``frc_ix[IX0:IX1].reshape(N, IW)`` and
+#: search state ``states[ST0:ST1].reshape(STN, STW)`` (:mod:`core.compiled.layout`).
+FRC_TAB_FIELDS = ("fd0", "fd1", "n", "fw", "ix0", "ix1", "iw", "st0", "st1", "st_n", "st_w")
+FT_FD0, FT_FD1, FT_N, FT_FW, FT_IX0, FT_IX1, FT_IW, FT_ST0, FT_ST1, FT_STN, FT_STW = range(len(FRC_TAB_FIELDS))
+FRC_TAB_WIDTH = len(FRC_TAB_FIELDS)
 
 _f8, _i8 = types.float64, types.int64
 # C-contiguous arrays throughout: the compiler then knows the unit inner stride

@@ -15,6 +15,19 @@ coefficients):
 ``"jit-dop853"``
     Dormand–Prince 8(5,3) (Hairer, Nørsett & Wanner I, Sec. II.10), with the combined 5th/3rd order
     error estimate ``‖err₅‖² / √(‖err₅‖² + 0.01‖err₃‖²)`` of the Fortran DOP853.
+``"jit-rk4"``
+    The classical fourth-order Runge–Kutta method (Kutta 1901; Hairer, Nørsett & Wanner I,
+    Sec. II.1, Table 1.2, left) with a **fixed step** ``h``: four right-hand sides a step
+    (``k₁ … k₄`` at ``c = 0, ½, ½, 1``; the derivative at the step's end is the next step's ``k₁``),
+    no error control.  What it is for: a penalty-stiff model integrated at a step just inside the
+    stability boundary, where the step of an error-controlled explicit method is limited by
+    stability anyway and its error estimate is spent work (Exudyn's fastest configuration on the
+    stiff penalty chain is its explicit ``RK44`` at such a step).  Like every fixed-step method it gets the
+    global error estimate of :mod:`core.integrators.base` (defect of the corrected trapezoidal rule,
+    evaluated in the compiled loop from the step's end data: ``q̇ = Z v`` and ``q̈ = Z v̇ + Ż v``,
+    where ``Ż v = Z(q + q̇) v − Z(q) v`` exactly because ``Z`` is affine in ``q``): the run ends
+    ``"finished with warnings"`` when ``Σ εₙ > 1`` and ``"failed"`` at a step with no correct digit left
+    or a non-finite state (a step beyond the stability boundary diverges: the message says so).
 
 each as ``"<method>"`` (unstabilised), ``"<method>-baumgarte"`` (α = β = 10 s⁻¹ by default) and
 ``"<method>-projection"`` (Eich 1993; tolerance ``projection_tol`` defaults to ``atol``).
@@ -23,10 +36,12 @@ Step-size control (identical to ``scipy.integrate.RK45/DOP853``; Hairer, Nørset
 Sec. II.4): ``sc_i = atol + rtol · max(|y_i|, |ŷ_i|)``, ``err = ‖e / sc‖_RMS``, accept when
 ``err < 1``; ``h ← h · min(10, 0.9 err^{−1/(p̂+1)})`` (not above 1 after a rejection),
 ``h ← h · max(0.2, 0.9 err^{−1/(p̂+1)})`` on rejection; the initial step by the algorithm of
-Hairer, Nørsett & Wanner I, Sec. II.4 (scipy ``select_initial_step``).  A step that would pass the
-next output time is shortened to land on it, so output needs no interpolation; with one output
+Hairer, Nørsett & Wanner I, Sec. II.4 (scipy ``select_initial_step``).  A step that would pass
+the next output time is shortened to land on it, so output needs no interpolation; with one output
 point (``t_eval = [t_end]``) the step sequence is the scipy one and the results agree with the
-``rk45``/``dop853`` methods to round-off.
+``rk45``/``dop853`` methods to round-off.  ``jit-rk4`` has no step-size control: every step is the
+given ``h``, the last one before an output time shortened to land on it (or up to 1e-6 h longer,
+rather than leave a sliver of a step from the round-off of ``t``).
 
 Failure is honest: a non-positive pivot of the Schur complement (dependent constraints, singular
 configuration), coincident spring-damper points, a step below ``10 ulp(t)`` (non-finite stages
@@ -40,6 +55,7 @@ Schur factorisations (one per right-hand side and per projection stage).
 References
 ----------
 J. R. Dormand, P. J. Prince, J. Comput. Appl. Math. 6 (1980) 19–26.
+W. Kutta, Z. Math. Phys. 46 (1901) 435–453.
 E. Eich, SIAM J. Numer. Anal. 30(5) (1993) 1467–1482.
 E. Hairer, S. P. Nørsett, G. Wanner, *Solving Ordinary Differential Equations I*, 2nd ed., 1993.
 """
@@ -60,22 +76,34 @@ from ..compiled import layout as _l
 from ..compiled import protocol as _p
 from ..compiled.cache import notify_if_cold
 from ..errors import InputError, NotCompilable, NumericalFailure
-from .base import STATUS_FAILED, STATUS_RUNNING, Integrator, register
+from .base import NO_CORRECT_DIGIT, STATUS_FAILED, STATUS_RUNNING, Integrator, register
 from .index1 import DEFAULT_BAUMGARTE
 
 _jit = numba.njit(cache=True, fastmath=False, boundscheck=False)
 _internal = numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+# arrays only, nothing allocated: without numba's reference counting, whose atomic counts of every
+# view made the fixed-step error estimate a sixth of an RK4 step's time (the functions it calls are
+# compiled in the same mode: numba's callees inherit the flag where they do not set it, so only
+# array-only code may be called from here)
+_internal_norc = numba.njit(cache=True, fastmath=False, boundscheck=False, no_cpython_wrapper=True,
+                            no_cfunc_wrapper=True, _nrt=False)
 
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
-ERR_RK45, ERR_DOP853 = 0, 1
+ERR_RK45, ERR_DOP853, ERR_FIXED = 0, 1, 2
 # counters array layout
 C_STEPS, C_REJ, C_RHS, C_FACT, C_IASTI, C_NONSTI, C_STIFF = 0, 1, 2, 3, 4, 5, 6
 # loop exit codes (besides the kernel status codes of core.compiled)
 EXIT_REACHED, EXIT_MAX_STEPS, EXIT_TOO_SMALL, EXIT_STIFF = 100, 101, 102, 103
+#: fixed step (jit-rk4): a step with no correct digit left (base.NO_CORRECT_DIGIT), a non-finite state
+EXIT_NO_DIGIT, EXIT_DIVERGED = 104, 105
+# out_info layout
+I_T, I_H, I_TOLD, I_TFAIL, I_TSTIFF, I_HL, I_EST, I_EPSMAX, I_TEPSMAX, I_EMAX, I_SIZE = range(11)
 #: Stiffness test of Hairer's DOPRI5/DOP853 codes: h|λ| estimated after every accepted step; stiff
 #: after 15 consecutive estimates beyond the method's stability boundary on the negative real axis
-#: (3.25 DOPRI5, 6.1 DOP853), cleared after 6 below it (Hairer, Nørsett & Wanner I, Sec. IV.2).
-STIFF_BOUND = {"rk45": 3.25, "dop853": 6.1}
+#: (3.25 DOPRI5, 6.1 DOP853; 2.78 for the classical RK4, whose stability domain reaches −2.785),
+#: cleared after 6 below it (Hairer & Wanner II, Sec. IV.2: the stability domains, Fig. 2.1, and the
+#: automatic stiffness detection of the codes).
+STIFF_BOUND = {"rk45": 3.25, "dop853": 6.1, "rk4": 2.78}
 STIFF_STEPS, NONSTIFF_STEPS = 15, 6
 STIFF_OFF, STIFF_WARN, STIFF_FAIL = 0, 1, 2
 DEFAULT_STIFFNESS = "warn"
@@ -104,19 +132,73 @@ def _rms(e, y, y_new, rtol, atol):
     return np.sqrt(acc / e.shape[0])
 
 
+@_internal_norc
+def _fixed_step_defect(lay, nq, h, t_new, y, y_new, f0, f1, w_err, tmp, rtol, atol, out_info):
+    r"""Local error estimate of a fixed step (:mod:`core.integrators.base`, module docstring).
+
+    .. math::
+
+        e = q_1 - q_0 - \tfrac{h}{2}(\dot q_0 + \dot q_1) - \tfrac{h^2}{12}(\ddot q_0 - \ddot q_1),
+        \qquad \ddot q = Z(q)\,\dot v + \dot Z v,\quad \dot Z v = Z(q + \dot q)\,v - Z(q)\,v
+
+    (``Z`` affine in ``q``, :func:`core.compiled.dynamics.qdot`, so the difference is exact);
+    ``q̇, v̇`` are the right-hand sides ``f0``, ``f1`` at the step's ends.  Adds
+    ``ε = ‖e / (atol + rtol max(|q₀|, |q₁|))‖_RMS`` to ``out_info[I_EST]`` and keeps the largest;
+    returns ``EXIT_NO_DIGIT`` when ``‖e‖∞`` exceeds the state's size (``base.NO_CORRECT_DIGIT``),
+    ``EXIT_DIVERGED`` when ``e`` is not finite, else ``OK``.
+    """
+    for end in range(2):
+        yy = y if end == 0 else y_new
+        ff = f0 if end == 0 else f1
+        row = w_err[end]
+        _d.qdot(lay, yy[:nq], ff[nq:], row)  # Z(q) v̇
+        for i in range(nq):
+            w_err[2, i] = yy[i] + ff[i]
+        _d.qdot(lay, w_err[2], yy[nq:], tmp[:nq])  # Z(q + q̇) v
+        for i in range(nq):
+            row[i] += tmp[i] - ff[i]  # + Ż v
+    acc = 0.0
+    emax = 0.0
+    size = atol
+    for i in range(nq):
+        e = (y_new[i] - y[i] - 0.5 * h * (f0[i] + f1[i]) - h * h / 12.0 * (w_err[0, i] - w_err[1, i]))
+        sc = atol + rtol * max(abs(y[i]), abs(y_new[i]))
+        acc += (e / sc) ** 2
+        emax = max(emax, abs(e))
+        size = max(size, abs(y[i]), abs(y_new[i]))
+    eps = np.sqrt(acc / nq) if nq > 0 else 0.0
+    if not np.isfinite(eps):
+        return EXIT_DIVERGED
+    if emax > NO_CORRECT_DIGIT * size:
+        out_info[I_EMAX] = emax
+        out_info[I_SIZE] = size
+        return EXIT_NO_DIGIT
+    out_info[I_EST] += eps
+    if eps > out_info[I_EPSMAX]:
+        out_info[I_EPSMAX] = eps
+        out_info[I_TEPSMAX] = t_new
+    return _p.OK
+
+
 @_jit
 def advance(cd, states, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, A, B, C, E, E3, E5, err_kind,
             err_exp, rtol, atol, max_step, alpha, beta, projection, proj_tol, max_proj_iter, stiff_bound, stiff_action,
-            stateful, K, y_new, y_old, f_old, tmp, y_st, lam, counters, out_info):
+            stateful, K, y_new, y_old, f_old, tmp, y_st, w_err, lam, counters, out_info):
     r"""Take accepted steps from ``t`` until ``t_stop`` (or ``max_steps``); ``y``, ``f`` updated in place.
 
     ``need_f``: evaluate ``f = F(t, y)`` first (initial state, after a projection); with
     ``max_steps = 0`` that is all it does.  Every right-hand side of the loop goes through one
     call site, where :func:`_rhs` is inlined (one copy of the kernels to compile).
     ``y_old``/``f_old`` receive the state and derivative at the start of the last accepted step.
-    ``out_info = [t, h_abs, t_old, t_fail, t_stiff, h|λ|]``.  Returns an exit code: ``EXIT_REACHED``,
-    ``EXIT_MAX_STEPS`` or a failure (kernel status, ``EXIT_TOO_SMALL``, ``EXIT_STIFF``).  With
+    ``out_info = [t, h_abs, t_old, t_fail, t_stiff, h|λ|, Σε, ε_max, t(ε_max), ‖e‖∞, state size]``
+    (indices ``I_*``; the last five are the fixed-step error estimate).  Returns an exit code:
+    ``EXIT_REACHED``, ``EXIT_MAX_STEPS`` or a failure (kernel status, ``EXIT_TOO_SMALL``,
+    ``EXIT_STIFF``, and for the fixed step ``EXIT_NO_DIGIT``, ``EXIT_DIVERGED``).  With
     ``stateful``, the kinds' search-state kernels run after every accepted step (and only then).
+
+    Fixed step (``err_kind == ERR_FIXED``): ``h_abs`` is the step; every step is accepted unless it
+    diverges; the defect ``e`` of the module docstring is evaluated with the scratch rows
+    ``w_err[0:3]`` (length ``n_q``) and its ``ε`` summed into ``out_info[I_EST]``.
 
     Stiffness test (Hairer's codes): ``h|λ| ≈ h ‖f(ŷ) − f(y_s)‖ / ‖ŷ − y_s‖`` from the last internal
     stage ``y_s`` (at ``c = 1``) and the new solution ``ŷ`` — a difference quotient of the Jacobian
@@ -129,6 +211,8 @@ def advance(cd, states, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, 
     lay = cd.lay
     nq = lay[4]
     constrained = cd.act.shape[0] > 0
+    fixed = err_kind == ERR_FIXED
+    h_fix = h_abs
     while True:
         if need_f:
             for i in range(n):
@@ -142,13 +226,19 @@ def advance(cd, states, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, 
             continue
         if t >= t_stop:
             out_info[0] = t
-            out_info[1] = h_abs
+            out_info[1] = h_fix if fixed else h_abs
             return EXIT_REACHED
         if steps >= max_steps:
             out_info[0] = t
-            out_info[1] = h_abs
+            out_info[1] = h_fix if fixed else h_abs
             return EXIT_MAX_STEPS
         min_step = 10.0 * abs(np.nextafter(t, np.inf) - t)
+        if fixed:
+            h_abs = h_fix
+            if t_stop - t < (1.0 + 1e-6) * h_fix:
+                # the last step before the output time lands on it: no sliver of a step left by
+                # the round-off of t accumulated over thousands of steps (a step up to 1e-6 h longer)
+                h_abs = t_stop - t
         if h_abs > max_step:
             h_abs = max_step
         elif h_abs < min_step:
@@ -197,6 +287,13 @@ def advance(cd, states, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, 
                 out_info[0] = t
                 out_info[3] = ts
                 return st
+            if fixed:
+                code = _fixed_step_defect(lay, nq, h, t_new, y, y_new, K[0], K[ns], w_err, tmp, rtol, atol, out_info)
+                if code != _p.OK or st == _p.NONFINITE:
+                    out_info[0] = t
+                    out_info[3] = t_new
+                    return EXIT_DIVERGED if (code == EXIT_DIVERGED or st == _p.NONFINITE) else code
+                break
             # error estimate (non-finite stages give a NaN error: rejected)
             if err_kind == ERR_RK45:
                 for i in range(n):
@@ -288,6 +385,16 @@ def advance(cd, states, ws, t, y, f, need_f, t_stop, t_bound, h_abs, max_steps, 
         counters[C_STEPS] += 1
 
 
+class ClassicalRK4:
+    """Butcher tableau of the classical fourth-order method (Kutta 1901; Hairer, Nørsett & Wanner I,
+    Sec. II.1, Table 1.2, left), in the layout of scipy's ``RungeKutta`` classes."""
+
+    A = np.array([[0.0, 0.0, 0.0, 0.0], [0.5, 0.0, 0.0, 0.0], [0.0, 0.5, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
+    B = np.array([1.0, 2.0, 2.0, 1.0]) / 6.0
+    C = np.array([0.0, 0.5, 0.5, 1.0])
+    order = 4
+
+
 def compiled_multipliers(integ, t, q, v) -> np.ndarray:
     """λ of :func:`core.compiled.dynamics.accelerations` without Baumgarte terms at ``(t, q, v)``
     (equal to :func:`core.dynamics.accelerations`' to round-off, microseconds instead of a sparse
@@ -323,17 +430,24 @@ class CompiledRK(Integrator):
     """
 
     scipy_solver: type = _si.RK45
+    #: ``"rk45"``, ``"dop853"`` (error-controlled) or ``"rk4"`` (fixed step)
+    tableau = "rk45"
     stabilization = "none"
     #: steps land on output times: simulate() calls advance(t_out) instead of step() + dense output
     steps_to_output = True
 
     @classmethod
     def accepted_options(cls):
+        # the fixed step has no stiffness test: a step beyond the stability boundary diverges
+        # within a few steps and fails on the defect check, and at a step just inside it Hairer's
+        # difference quotient (two stages at c = 1) measured h|λ| ≈ 126 on the stiff chain, which
+        # integrates correctly at that step
+        stiff = () if cls.fixed_step else ("stiffness",)
         if cls.stabilization == "baumgarte":
-            return ("alpha", "beta", "stiffness")
+            return ("alpha", "beta") + stiff
         if cls.stabilization == "projection":
-            return ("projection_tol", "max_projection_iter", "stiffness")
-        return ("stiffness",)
+            return ("projection_tol", "max_projection_iter") + stiff
+        return stiff
 
     @classmethod
     def applicable(cls, system):
@@ -365,8 +479,8 @@ class CompiledRK(Integrator):
         stiffness = o.get("stiffness", DEFAULT_STIFFNESS)
         if stiffness not in actions:
             raise InputError(f"{self.name}: stiffness must be one of {sorted(actions)}, got {stiffness!r}")
-        self._stiff_action = actions[stiffness]
-        self._stiff_bound = STIFF_BOUND["dop853" if self.scipy_solver is _si.DOP853 else "rk45"]
+        self._stiff_action = STIFF_OFF if self.fixed_step else actions[stiffness]
+        self._stiff_bound = STIFF_BOUND[self.tableau]
         #: time [s] where the stiffness test first fired (None if it never did)
         self.stiffness_detected_at: float | None = None
         s = self.scipy_solver
@@ -374,7 +488,10 @@ class CompiledRK(Integrator):
         self._B = np.ascontiguousarray(s.B, float)
         self._C = np.ascontiguousarray(s.C, float)
         ns = len(self._B)
-        if s is _si.DOP853:
+        if self.fixed_step:
+            self._err_kind = ERR_FIXED
+            self._E = self._E3 = self._E5 = np.zeros(ns + 1)
+        elif s is _si.DOP853:
             self._err_kind = ERR_DOP853
             self._E = np.zeros(ns + 1)
             self._E3 = np.ascontiguousarray(s.E3, float)
@@ -383,7 +500,7 @@ class CompiledRK(Integrator):
             self._err_kind = ERR_RK45
             self._E = np.ascontiguousarray(s.E, float)
             self._E3 = self._E5 = np.zeros(ns + 1)
-        self._err_exp = -1.0 / (s.error_estimator_order + 1)
+        self._err_exp = 0.0 if self.fixed_step else -1.0 / (s.error_estimator_order + 1)
         n = system.n_q + system.n_v
         self._K = np.zeros((ns + 1, n))
         self._y = np.concatenate([self.q, self.v])
@@ -391,8 +508,9 @@ class CompiledRK(Integrator):
         self._y_new, self._y_old, self._f_old, self._tmp = (np.zeros(n) for _ in range(4))
         self._lam = np.zeros(max(system.n_c, 1))
         self._cnt = np.zeros(7, np.int64)
-        self._info = np.zeros(6)
-        self._info[4:] = np.nan
+        self._info = np.zeros(11)
+        self._info[I_TSTIFF:I_EST] = np.nan
+        self._w_err = np.zeros((3, system.n_q))
         self._y_st = np.zeros(n)
         self._h_abs = 0.0
         if self.stabilization == "projection":
@@ -405,7 +523,9 @@ class CompiledRK(Integrator):
         if st != _p.OK:
             raise InputError(f"{self.name}: right-hand side fails at the initial state of {system.name!r}: "
                              f"{self._status_message(st, (self.t, self._y))}")
-        if self.h is not None:
+        if self.fixed_step:
+            self._h_abs = min(self.h, self.max_step)
+        elif self.h is not None:
             self._h_abs = min(self.h, self.t_bound - self.t)
         else:
             self._h_abs = self._initial_step(s.error_estimator_order)
@@ -419,7 +539,7 @@ class CompiledRK(Integrator):
                        self._err_exp, self.rtol, self.atol, self.max_step, self.alpha, self.beta,
                        self.stabilization == "projection", self.projection_tol, self.max_projection_iter,
                        self._stiff_bound, self._stiff_action, self._cm.stateful, self._K, self._y_new, self._y_old,
-                       self._f_old, self._tmp, self._y_st, self._lam, self._cnt, self._info)
+                       self._f_old, self._tmp, self._y_st, self._w_err, self._lam, self._cnt, self._info)
 
     def multipliers(self, t, q, v):
         """The index-1 multipliers at ``(t, q, v)`` on the compiled path (:func:`compiled_multipliers`)."""
@@ -488,8 +608,11 @@ class CompiledRK(Integrator):
         self._h_abs = float(info[1])
         self.q, self.v = self._y[:nq].copy(), self._y[nq:].copy()
         self.a = self._f[nq:].copy()
-        if self.stiffness_detected_at is None and np.isfinite(info[4]):
-            self.stiffness_detected_at = float(info[4])
+        if self.stiffness_detected_at is None and np.isfinite(info[I_TSTIFF]):
+            self.stiffness_detected_at = float(info[I_TSTIFF])
+        if self.fixed_step:
+            self.error_estimate = float(info[I_EST])
+            self._largest_local = (float(info[I_EPSMAX]), float(info[I_TEPSMAX]))
         if code in (EXIT_REACHED, EXIT_MAX_STEPS):
             if self.t >= self.t_bound - 1e-12 * max(1.0, abs(self.t_bound)):
                 if self.stiffness_detected_at is not None:
@@ -507,6 +630,14 @@ class CompiledRK(Integrator):
             why = (f"the problem became stiff at t = {info[3]:.6g} s: h|λ| ≈ {info[5]:.3g} beyond the stability "
                    f"boundary {self._stiff_bound} of the method on {STIFF_STEPS} consecutive steps (Hairer's "
                    "stiffness test); use an implicit method (radau-ggl, generalized-alpha) or stiffness='warn'")
+        elif code == EXIT_DIVERGED:
+            why = (f"the state became non-finite in the step to t = {info[3]:.6g} s with the fixed step h = {self.h:.3g} s: "
+                   f"the step is beyond the method's stability boundary (h|λ| ≤ {self._stiff_bound} on the negative "
+                   "real axis) or the motion itself diverges; use a smaller h or an implicit method (jit-radau)")
+        elif code == EXIT_NO_DIGIT:
+            why = (f"local error estimate {info[I_EMAX]:.3g} exceeds the size of the state ({info[I_SIZE]:.3g}) with "
+                   f"the fixed step h = {self.h:.3g} s in the step to t = {info[3]:.6g} s: no correct digit left; "
+                   "use a smaller h")
         elif code == _p.PROJECTION:
             why = (f"coordinate projection did not reach ‖Φ‖ ≤ {self.projection_tol:g} in "
                    f"{self.max_projection_iter} iterations at t = {info[3]:.6g} s")
@@ -527,21 +658,22 @@ class CompiledRK(Integrator):
 
 
 def _make_class(key: str, stab: str) -> type[CompiledRK]:
-    scipy_cls = {"rk45": _si.RK45, "dop853": _si.DOP853}[key]
+    scipy_cls = {"rk45": _si.RK45, "dop853": _si.DOP853, "rk4": ClassicalRK4}[key]
+    title = {"rk45": "RK45", "dop853": "DOP853", "rk4": "fixed-step classical RK4"}[key]
     name = f"jit-{key}" + ("" if stab == "none" else f"-{stab}")
     label = {"none": "unstabilised", "baumgarte": "Baumgarte-stabilised",
              "projection": "with coordinate projection"}[stab]
-    cls_name = f"Compiled{scipy_cls.__name__}" + {"none": "", "baumgarte": "Baumgarte", "projection": "Projection"}[stab]
-    doc = (f"Index-1 formulation ({label}) on a compiled {scipy_cls.__name__} loop.\n\n"
+    cls_name = f"Compiled{key.upper()}" + {"none": "", "baumgarte": "Baumgarte", "projection": "Projection"}[stab]
+    doc = (f"Index-1 formulation ({label}) on a compiled {title} loop.\n\n"
            f"Registry name ``{name!r}``.  See :mod:`core.integrators.compiled_rk` and :class:`CompiledRK`.\n")
     cls = type(cls_name, (CompiledRK,), dict(
-        name=name, summary=f"index-1 {label}, compiled {scipy_cls.__name__} (numba)", scipy_solver=scipy_cls,
-        stabilization=stab, __doc__=doc, __module__=__name__))
+        name=name, summary=f"index-1 {label}, compiled {title} (numba)", scipy_solver=scipy_cls, tableau=key,
+        fixed_step=key == "rk4", stabilization=stab, __doc__=doc, __module__=__name__))
     return register(cls)
 
 
 COMPILED_METHODS: dict[str, type[CompiledRK]] = {}
-for _key in ("rk45", "dop853"):
+for _key in ("rk45", "dop853", "rk4"):
     for _stab in ("none", "baumgarte", "projection"):
         _cls = _make_class(_key, _stab)
         COMPILED_METHODS[_cls.name] = _cls

@@ -46,6 +46,7 @@ from core.integrators import METHODS, simulate
 from core.integrators.compiled_rk import COMPILED_METHODS
 from core.model import ModelBuilder
 
+FINISHED = ("finished", "finished with warnings")
 RT = 1e-12  # round-off agreement of two evaluations of the same formulas
 
 
@@ -465,8 +466,97 @@ def test_step_contract_one_step_per_call():
 
 
 def test_registry_names():
-    assert set(COMPILED_METHODS) == {f"jit-{k}{s}" for k in ("rk45", "dop853") for s in ("", "-baumgarte", "-projection")}
+    assert set(COMPILED_METHODS) == {f"jit-{k}{s}" for k in ("rk45", "dop853", "rk4")
+                                     for s in ("", "-baumgarte", "-projection")}
     assert all(name in METHODS for name in COMPILED_METHODS)
+    assert [n for n in COMPILED_METHODS if METHODS[n].fixed_step] == ["jit-rk4", "jit-rk4-baumgarte", "jit-rk4-projection"]
+
+
+# --------------------------------------------------------------------------------------------
+# the compiled fixed-step classical RK4
+# --------------------------------------------------------------------------------------------
+
+
+def _numpy_rk4(model, h, n_steps):
+    """Kutta's classical RK4 written out on the numpy right-hand side (:func:`core.dynamics.accelerations`)."""
+    def f(t, y):
+        q, v = y[:model.n_q], y[model.n_q:]
+        return np.concatenate([model.qdot(q, v), accelerations_numpy(model, t, q, v)[0]])
+
+    y, t = np.concatenate([model.q0, model.v0]), 0.0
+    for _ in range(n_steps):
+        k1 = f(t, y)
+        k2 = f(t + h / 2, y + h / 2 * k1)
+        k3 = f(t + h / 2, y + h / 2 * k2)
+        k4 = f(t + h, y + h * k3)
+        y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        t += h
+    return y
+
+
+@pytest.mark.parametrize("spatial", [False, True])
+def test_rk4_is_the_classical_method(spatial):
+    """The compiled loop takes the classical RK4 step: 40 steps on a penalty chain equal the same
+    tableau written out on the numpy right-hand side to round-off."""
+    model = models.n_link_chain(3, planar=not spatial, spatial=spatial, stiff_k=1e4)
+    h, n = 2e-3, 40
+    res = simulate(model, (0.0, n * h), "jit-rk4", h=h, t_eval=[n * h], compute_multipliers=False)
+    assert res.counters["n_steps"] == n and res.counters["n_rhs"] == 4 * n + 1
+    ref = _numpy_rk4(model, h, n)
+    _close(res.q[-1], ref[:model.n_q], "rk4 q", 1e-10)
+    _close(res.v[-1], ref[model.n_q:], "rk4 v", 1e-10)
+
+
+def test_rk4_fourth_order_and_the_peer_step_on_the_stiff_chain():
+    """Penalty chain N = 2, k = 1e6 N/m, 0.2 s against the independent DOP853 reference
+    (core.benchmarks.references): halving h divides the tip error by 2⁴ (12–20 accepted), and at a
+    step just inside the stability boundary the run is stable and accurate to 1e-6 m."""
+    from core.benchmarks.references import stiff_chain_tip_reference
+
+    model = models.n_link_chain(2, planar=True, stiff_k=1e6)
+    t_end = 0.2
+    ref = stiff_chain_tip_reference(2, 1e6, t_end=t_end)
+    errs = {}
+    for h in (t_end / 1000, t_end / 2000):
+        res = simulate(model, (0.0, t_end), "jit-rk4", h=h, t_eval=[t_end], compute_multipliers=False)
+        assert res.status in FINISHED, res.message
+        errs[h] = float(np.linalg.norm(models.chain_tip(model, res.q[-1]) - ref))
+    ratio = errs[t_end / 1000] / errs[t_end / 2000]
+    assert 12.0 < ratio < 20.0, (errs, ratio)
+    assert errs[t_end / 1000] < 1e-6
+
+
+def test_rk4_beyond_the_stability_boundary_fails_and_keeps_the_last_state():
+    """k = 1e8 N/m at h = 1 ms: h|λ| far beyond 2.78, the state diverges; the run fails naming the
+    stability boundary and keeps the outputs computed before."""
+    model = models.n_link_chain(2, planar=True, stiff_k=1e8)
+    res = simulate(model, (0.0, 0.5), "jit-rk4", h=1e-3, t_eval=np.linspace(0.0, 0.5, 51),
+                   compute_multipliers=False)
+    assert res.status == "failed"
+    assert "stability boundary" in res.message or "no correct digit" in res.message, res.message
+    assert res.t[-1] < 0.5 and np.all(np.isfinite(res.q))
+
+
+def test_rk4_global_error_estimate_and_output_times():
+    """A fixed step too coarse for the tolerance ends "finished with warnings" with the summed
+    estimate named; steps land on output times (a shortened step before each); options of the
+    error-controlled methods (stiffness) and a missing h are refused."""
+    from core.errors import InputError, UnknownOptionError
+
+    model = models.n_link_chain(2, planar=True)
+    t_eval = np.linspace(0.0, 1.0, 7)
+    coarse = simulate(model, (0.0, 1.0), "jit-rk4-projection", h=0.01, t_eval=t_eval, rtol=1e-10, atol=1e-12)
+    assert coarse.status == "finished with warnings" and "fixed step h = 0.01 s: estimated global error" in coarse.message
+    np.testing.assert_array_equal(coarse.t, t_eval)
+    assert coarse.counters["n_steps"] == 6 * 17  # 16 full steps and one of 2/3 h per output interval
+    fine = simulate(model, (0.0, 1.0), "jit-rk4-projection", h=0.001, t_eval=t_eval, rtol=1e-4, atol=1e-6)
+    assert fine.status == "finished", fine.message
+    ref, _ = n_link_chain_reference(2)
+    assert float(np.linalg.norm(models.chain_tip(model, fine.q[-1]) - ref)) < 1e-6
+    with pytest.raises(UnknownOptionError):
+        simulate(model, (0.0, 1.0), "jit-rk4", h=0.01, stiffness="off")
+    with pytest.raises(InputError, match="fixed-step method: give a step size h"):
+        simulate(model, (0.0, 1.0), "jit-rk4")
 
 
 # --------------------------------------------------------------------------------------------

@@ -60,16 +60,18 @@ def test_no_clean_finish_with_an_error_beyond_ten_tolerances(pendulum, method):
             assert r.warnings and r.message.count("warning:") == len(r.warnings)
 
 
-def test_fixed_step_estimate_tracks_the_global_error(pendulum):
+@pytest.mark.parametrize("method,h", [("generalized-alpha", 0.01), ("hem3", 0.01), ("jit-rk4", 0.02),
+                                      ("jit-rk4-projection", 0.05)])
+def test_fixed_step_estimate_tracks_the_global_error(pendulum, method, h):
     """The summed local estimate is within a factor 3 of the true error (measured 0.3–2.2 on this
-    pendulum over h = 2e-3 … 5e-2 for hem3, hem4, generalized-alpha and hht)."""
+    pendulum over h = 2e-3 … 5e-2 for hem3, hem4, generalized-alpha and hht; 0.75–2.4 for the
+    jit-rk4 variants where the estimate exceeds 1, computed in their compiled loop)."""
     model, exact_xy = pendulum
-    for method in ("generalized-alpha", "hem3"):
-        r = simulate(model, (0.0, T_END), method, t_eval=T_EVAL, h=0.01, rtol=1e-6, atol=1e-8)
-        err = float(np.max(np.abs(r.q[:, :2] - exact_xy))) / 1e-6
-        est = float(r.message.split("estimated global error ")[1].split(" ×")[0])
-        assert r.status == "finished with warnings"
-        assert err / 3 < est < 3 * err, (method, est, err)
+    r = simulate(model, (0.0, T_END), method, t_eval=T_EVAL, h=h, rtol=1e-6, atol=1e-8)
+    err = float(np.max(np.abs(r.q[:, :2] - exact_xy))) / 1e-6
+    est = float(r.message.split("estimated global error ")[1].split(" ×")[0])
+    assert r.status == "finished with warnings"
+    assert err / 3 < est < 3 * err, (method, est, err)
 
 
 @pytest.mark.parametrize("method,h", [("generalized-alpha", 10.0), ("hht", 5.0), ("hht", 10.0)])

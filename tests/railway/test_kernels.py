@@ -78,3 +78,18 @@ def test_evaluate_columns_cover_what_evaluate_reads():
     for a, b in K.EVALUATE_COLUMNS:
         covered |= set(range(a, b))
     assert covered == read and max(covered) + 1 == K.FRAME_COLUMNS
+
+
+def test_wrap_angle_is_the_angle_of_the_unit_phasor():
+    """The scan's lead-angle roots phi ± acos(c), phi in (-pi, pi], wrapped by arithmetic: the result
+    lies in (-pi, pi] and has the same cosine and sine as the unwrapped angle (what
+    atan2(sin x, cos x) gave before, to round-off)."""
+    rng = np.random.default_rng(7)
+    phi = rng.uniform(-np.pi, np.pi, 2000)
+    acs = np.arccos(rng.uniform(-1.0, 1.0, 2000))
+    x = np.concatenate([phi + acs, phi - acs, [np.pi, 2 * np.pi, -np.pi + 1e-12, 0.0]])
+    w = np.array([K.wrap_angle(float(v)) for v in x])
+    assert np.all(w > -np.pi) and np.all(w <= np.pi)
+    np.testing.assert_allclose(np.cos(w), np.cos(x), rtol=0, atol=4e-15)
+    np.testing.assert_allclose(np.sin(w), np.sin(x), rtol=0, atol=4e-15)
+    np.testing.assert_allclose(w, np.arctan2(np.sin(x), np.cos(x)), rtol=0, atol=1e-14)

@@ -434,6 +434,16 @@ if HAVE_NUMBA:
                 r = fp[j]
         return r
 
+    @njit_norc
+    def wrap_angle(x):
+        """``x`` wrapped into (-pi, pi], for ``x`` in (-2 pi, 2 pi] (a sum or difference of an angle
+        of (-pi, pi] and one of [0, pi]); equal to ``atan2(sin x, cos x)`` up to round-off."""
+        if x > np.pi:
+            return x - 2.0 * np.pi
+        if x <= -np.pi:
+            return x + 2.0 * np.pi
+        return x
+
     @njit
     def scan(r, ax, d, pos, tan, lat, up, sig, L, yg, rg, F1g, side_left, b0, u0, Y0, Z0,
              b1, u1, Y1, Z1, ulo, uhi, theta, s0, n_rank, out):
@@ -442,6 +452,7 @@ if HAVE_NUMBA:
         Yo = np.empty(G); Zw = np.empty(G); xi = np.empty(G); beta = np.empty(G)
         gap = np.empty(G); h4 = np.empty(G); ok = np.empty(G, dtype=np.bool_)
         gmid = np.empty(G - 1); tt = np.empty(G - 1); th = np.empty(G)
+        cbeta = np.empty(G); sbeta = np.empty(G)
         ug = np.empty(G); Yr = np.empty(G); Zr = np.empty(G)
         for p in range(P):
             # the lead angle of each profile line (ContactSearch.scan_lead_angle)
@@ -453,13 +464,22 @@ if HAVE_NUMBA:
             at = ax[p, 0] * tan[p, 0] + ax[p, 1] * tan[p, 1] + ax[p, 2] * tan[p, 2]
             Rc = np.hypot(Ac, Bc)
             phi = np.arctan2(Bc, Ac)
+            cphi, sphi = (Ac / Rc, Bc / Rc) if Rc > 0.0 else (1.0, 0.0)  # phi = atan2(0, 0) = 0
             for g in range(G):
-                c = -F1g[p, g] * at / Rc
-                acs = np.arccos(min(max(c, -1.0), 1.0))
-                t1a = np.arctan2(np.sin(phi + acs), np.cos(phi + acs))
-                t2a = np.arctan2(np.sin(phi - acs), np.cos(phi - acs))
-                th[g] = t1a if abs(t1a) <= abs(t2a) else t2a
-                ct, st = np.cos(th[g]), np.sin(th[g])
+                # the two roots phi ± acs wrapped into (-pi, pi] by arithmetic, and their cosine
+                # and sine from the angle-sum formulas (SeedScan's scan_lead_angle): four
+                # transcendental calls a grid point fewer than wrapping through atan2(sin, cos)
+                c = min(max(-F1g[p, g] * at / Rc, -1.0), 1.0)
+                acs = np.arccos(c)
+                sa = np.sqrt((1.0 - c) * (1.0 + c))  # sin(acs), accurate also near |c| = 1
+                t1a = wrap_angle(phi + acs)
+                t2a = wrap_angle(phi - acs)
+                if abs(t1a) <= abs(t2a):
+                    th[g] = t1a
+                    ct, st = cphi * c - sphi * sa, sphi * c + cphi * sa
+                else:
+                    th[g] = t2a
+                    ct, st = cphi * c + sphi * sa, sphi * c - cphi * sa
                 e0 = ct * d[p, 0] + st * f0
                 e1 = ct * d[p, 1] + st * f1
                 e2 = ct * d[p, 2] + st * f2
@@ -473,8 +493,11 @@ if HAVE_NUMBA:
                 t0 = -F1g[p, g] * e0 + sig[p] * ax[p, 0]
                 t1 = -F1g[p, g] * e1 + sig[p] * ax[p, 1]
                 t2 = -F1g[p, g] * e2 + sig[p] * ax[p, 2]
-                beta[g] = np.arctan2(t0 * up[p, 0] + t1 * up[p, 1] + t2 * up[p, 2],
-                                     (t0 * lat[p, 0] + t1 * lat[p, 1] + t2 * lat[p, 2]) * sig[p])
+                bz = t0 * up[p, 0] + t1 * up[p, 1] + t2 * up[p, 2]
+                by = (t0 * lat[p, 0] + t1 * lat[p, 1] + t2 * lat[p, 2]) * sig[p]
+                beta[g] = np.arctan2(bz, by)
+                bn = np.hypot(by, bz)
+                cbeta[g], sbeta[g] = (by / bn, bz / bn) if bn > 0.0 else (1.0, 0.0)
             if side_left[p]:
                 interp3(beta, b0, u0, Y0, Z0, ug, Yr, Zr)
             else:
@@ -482,7 +505,7 @@ if HAVE_NUMBA:
             j0 = 0
             gbest = 1e300
             for g in range(G):
-                cb, sb = np.cos(beta[g]), np.sin(beta[g])
+                cb, sb = cbeta[g], sbeta[g]
                 dY, dZ = Yo[g] - Yr[g], Zw[g] - Zr[g]
                 ok[g] = (ug[g] > ulo[p]) and (ug[g] < uhi[p])
                 gap[g] = -dY * sb + dZ * cb if ok[g] else np.inf

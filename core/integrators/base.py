@@ -84,10 +84,11 @@ class Integrator:
         Initial state; defaults to ``system.q0``, ``system.v0``.
     rtol, atol : float
         Tolerances for error-controlled methods (and for Newton iterations of fixed-step ones).
-    h : float, optional
-        Step size for fixed-step methods; initial step for adaptive ones.
-    max_step : float
-        Largest step [s].
+    h : float or str, optional
+        Step size for fixed-step methods; initial step for adaptive ones [s], or a string with its
+        unit (``"0.25 ms"``, :func:`core.inputs.parse_quantity`).
+    max_step : float or str
+        Largest step [s] (or a string with its unit).
 
     Attributes
     ----------
@@ -129,6 +130,9 @@ class Integrator:
         t0, t_end = map(float, t_span)
         if not t_end > t0:
             raise InputError(f"{self.name}: t_span must have t_end > t0, got {t_span}")
+        h, max_step = _time_argument(self.name, "h", h), _time_argument(self.name, "max_step", max_step)
+        _check_number(self.name, "rtol", rtol)
+        _check_number(self.name, "atol", atol)
         if not (rtol > 0 and atol > 0):
             raise InputError(f"{self.name}: rtol and atol must be > 0, got rtol={rtol}, atol={atol}")
         if self.fixed_step and (h is None or not h > 0):
@@ -160,7 +164,9 @@ class Integrator:
         self.counters = dict(n_steps=0, n_rejected=0, n_rhs=0, n_jac=0, n_factor=0, n_newton=0)
         unknown = set(options) - set(self.accepted_options())
         if unknown:
-            raise UnknownOptionError(f"{self.name}: unknown option(s) {sorted(unknown)}; accepted: {sorted(self.accepted_options())}")
+            accepted = sorted(self.accepted_options())
+            raise UnknownOptionError(f"{self.name}: unknown option(s) {sorted(unknown)}; "
+                                     + (f"accepted: {accepted}" if accepted else "this method takes no options"))
         # elements with a search state start from the initial state and are told of accepted
         # steps only (core.forces.protocol)
         self._stateful = bool(getattr(system, "stateful", False))
@@ -362,6 +368,31 @@ def get_method(method: str | type[Integrator]) -> type[Integrator]:
     if not isinstance(method, str):
         raise InputError(f"method must be an integrator name or an Integrator subclass, got {method!r}")
     return METHODS[method]
+
+
+def _check_number(method: str, what: str, value, unit: str = "a tolerance") -> None:
+    """An :class:`InputError` unless ``value`` is None or a plain number (text, a flag or a list is
+    refused by name instead of failing a comparison later)."""
+    if value is None:
+        return
+    if isinstance(value, (str, bytes, bool)):
+        raise InputError(f"{method}: {what} must be a number ({unit}), got {value!r} ({type(value).__name__})")
+    try:
+        float(value)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{method}: {what} must be a number ({unit}), got {value!r} ({type(value).__name__}: "
+                         f"{exc})") from None
+
+
+def _time_argument(method: str, what: str, value):
+    """``h`` or ``max_step``: a number of seconds, or a string with its unit (``"1 ms"``, converted by
+    pint as every quantity a user gives, :func:`core.inputs.parse_quantity`)."""
+    if isinstance(value, str):
+        from ..inputs import parse_quantity
+
+        return parse_quantity(value, "s", where=f"{method}: {what}")
+    _check_number(method, what, value, "seconds, or a string with its unit")
+    return value
 
 
 def _initial_vector(method: str, system, what: str, value, n: int, kind: str) -> Array:

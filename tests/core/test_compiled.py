@@ -553,7 +553,7 @@ def test_rk4_global_error_estimate_and_output_times():
     assert fine.status == "finished", fine.message
     ref, _ = n_link_chain_reference(2)
     assert float(np.linalg.norm(models.chain_tip(model, fine.q[-1]) - ref)) < 1e-6
-    with pytest.raises(UnknownOptionError):
+    with pytest.raises(UnknownOptionError, match=r"unknown option\(s\) \['stiffness'\]; this method takes no options"):
         simulate(model, (0.0, 1.0), "jit-rk4", h=0.01, stiffness="off")
     with pytest.raises(InputError, match="fixed-step method: give a step size h"):
         simulate(model, (0.0, 1.0), "jit-rk4")

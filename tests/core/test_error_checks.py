@@ -146,3 +146,25 @@ def test_energy_check_flags_a_drifting_conservative_run(pendulum):
     r = simulate(model, (0.0, T_END), "rk45", rtol=1e-3, atol=1e-5, t_eval=T_EVAL)
     assert r.status == "finished with warnings"
     assert any(w.startswith("energy drift") and "what the tolerances allow" in w for w in r.warnings)
+
+
+@pytest.mark.parametrize("kw,message", [(dict(h=True), "h must be a number"), (dict(rtol="1e-6"), "rtol must be a number"),
+                                        (dict(max_step=[0.1]), "max_step must be a number"),
+                                        (dict(h="1 kg"), r"h: '1 kg' is a mass \(\[mass\]\), expected time"),
+                                        (dict(h="1,5 ms"), "h: '1,5 ms' has a comma")])
+def test_step_and_tolerances_that_are_not_numbers_are_refused_by_name(kw, message):
+    """A hurried user's h="1e-3" failed with a bare TypeError from a comparison deep in the
+    integrator's set-up; now a step is a number of seconds or a quantity with its unit (as every
+    input, docs/user-guide/checked-inputs.md), and anything else is refused naming the argument."""
+    for method in ("jit-rk4", "generalized-alpha", "rk45"):
+        with pytest.raises(InputError, match=f"{method}: {message}"):
+            simulate(simple_pendulum(bob="point"), (0.0, 0.1), method, **({"h": 1e-3} | kw))
+
+
+def test_a_step_with_its_unit_is_converted():
+    model = simple_pendulum(bob="point")
+    a = simulate(model, (0.0, 0.1), "jit-rk4", h="1 ms", t_eval=[0.1])
+    b = simulate(model, (0.0, 0.1), "jit-rk4", h=1e-3, t_eval=[0.1])
+    c = simulate(model, (0.0, 0.1), "jit-rk4", h="1e-3", t_eval=[0.1])  # a bare number as text: seconds
+    assert a.counters["n_steps"] == b.counters["n_steps"] == c.counters["n_steps"] == 100
+    np.testing.assert_array_equal(a.q, b.q)

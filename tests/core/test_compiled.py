@@ -945,3 +945,23 @@ def test_compiled_torsional_oscillator_and_bushing(method):
     res = simulate(model, (0.0, 3.0), method.replace("-projection", ""), t_eval=[3.0], rtol=1e-8, atol=1e-10)
     assert res.status == "finished", res.message
     assert abs(res.q[-1, 2] + 5.0 * 9.81 / 2e4) < 1e-6 and np.max(np.abs(res.q[-1, :2])) < 1e-6
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_force_kind_table_addresses_each_kinds_own_data(dim):
+    """``frc_tab`` (one row per force kind, read by the right-hand side instead of eight offset
+    arrays) addresses exactly the data, indices and search state each kind was packed with."""
+    from core.compiled.protocol import FT_FD0, FT_FD1, FT_FW, FT_IW, FT_IX0, FT_IX1, FT_N, FT_ST0, FT_ST1, FT_STN, FT_STW
+
+    cm = compile_model(_suspension_model(dim, seed=3, ground=True))
+    f, tab, states = cm.fields, cm.fields["frc_tab"], cm.initial_states()
+    assert len(cm.force_kinds) >= 2
+    for k, rec in enumerate(cm.force_kinds):
+        n = tab[k, FT_N]
+        np.testing.assert_array_equal(f["frc_fd"][tab[k, FT_FD0]:tab[k, FT_FD1]].reshape(n, tab[k, FT_FW]), rec.fd)
+        np.testing.assert_array_equal(f["frc_ix"][tab[k, FT_IX0]:tab[k, FT_IX1]].reshape(n, tab[k, FT_IW]), rec.ix)
+        st = states[tab[k, FT_ST0]:tab[k, FT_ST1]].reshape(tab[k, FT_STN], tab[k, FT_STW])
+        assert st.size == np.asarray(rec.state).size
+        np.testing.assert_array_equal(tab[k], [f["frc_fo"][k], f["frc_fo"][k + 1], f["frc_n"][k], f["frc_fw"][k],
+                                               f["frc_io"][k], f["frc_io"][k + 1], f["frc_iw"][k], f["st_off"][k],
+                                               f["st_off"][k + 1], f["st_n"][k], f["st_w"][k]])

@@ -80,6 +80,11 @@ def _ints(*cols) -> np.ndarray:
     return np.ascontiguousarray(np.column_stack([np.asarray(c, np.int64).reshape(-1) for c in cols]))
 
 
+def _groups(*cols) -> list:
+    """Body groups of one- or two-body elements (:attr:`CompiledForces.groups`): the bodies of each."""
+    return _ints(*cols).tolist()
+
+
 def _pair_slots(bi, bj, rows_per, nb) -> np.ndarray:
     """Slots (two bodies) of ``rows_per`` rows per element."""
     n = len(bi)
@@ -720,14 +725,14 @@ def compile_applied_forces(kind, layout) -> CompiledForces:
     fd = np.hstack([s, progs])
     ix = np.column_stack([kind.b, kind.body_frame.astype(np.int64), off + 3]).astype(np.int64)
     return CompiledForces(forces=applied_forces, fd=fd, ix=np.ascontiguousarray(ix), names=list(kind.names),
-                          what="applied force")
+                          what="applied force", groups=_groups(kind.b))
 
 
 def compile_applied_torques(kind, layout) -> CompiledForces:
     progs, off = _component_programs(kind, kind.names)
     ix = np.column_stack([kind.b, kind.body_frame.astype(np.int64), off]).astype(np.int64)
     return CompiledForces(forces=applied_torques, fd=np.ascontiguousarray(progs), ix=np.ascontiguousarray(ix),
-                          names=list(kind.names), what="applied torque")
+                          names=list(kind.names), what="applied torque", groups=_groups(kind.b))
 
 
 def compile_point_springs(kind, layout) -> CompiledForces:
@@ -821,7 +826,8 @@ def compile_rotational_spring_dampers(kind, layout) -> CompiledForces:
     fd = np.hstack([pad3(kind.fi), pad3(kind.gi), pad3(kind.fj), kind.k[:, None], kind.c[:, None],
                     kind.theta0[:, None], has, progs])
     return CompiledForces(forces=rotational_spring_dampers, fd=np.ascontiguousarray(fd), ix=_ints(kind.bi, kind.bj),
-                          names=list(kind.names), what="rotational spring-damper")
+                          names=list(kind.names), what="rotational spring-damper",
+                          groups=_groups(kind.bi, kind.bj))
 
 
 @_internal
@@ -914,7 +920,7 @@ def compile_bushings(kind, layout) -> CompiledForces:
     fd = np.hstack([pad3(kind.si), pad3(kind.sj), _pad_axes(kind.Mi), _pad_axes(kind.Mj), _pad6(kind.K),
                     _pad6(kind.C), _pad6(kind.x0)])
     return CompiledForces(forces=bushings, fd=np.ascontiguousarray(fd), ix=_ints(kind.bi, kind.bj),
-                          names=list(kind.names), what="bushing")
+                          names=list(kind.names), what="bushing", groups=_groups(kind.bi, kind.bj))
 
 
 # --- bump stop (dot-2 coordinate with a tabulated law) -------------------------------------------
@@ -970,7 +976,7 @@ def compile_bump_stops(kind, layout) -> CompiledForces:
                     kind.positive.astype(float)[:, None], kind.negative.astype(float)[:, None], D, kind.F, kind.S])
     ix = _ints(kind.bi, kind.bj, kind.n_rows, np.full(len(kind.bi), K))
     return CompiledForces(forces=bump_stops, fd=np.ascontiguousarray(fd), ix=ix, names=list(kind.names),
-                          what="bump stop")
+                          what="bump stop", groups=_groups(kind.bi, kind.bj))
 
 
 # --- spring in series with a damper (node = extra coordinate) -------------------------------------
@@ -1104,7 +1110,7 @@ def compile_plane_contacts(kind, layout) -> CompiledForces:
     fd = np.hstack([pad3(kind.s), pad3(kind.p0), pad3(kind.n), kind.R[:, None], kind.K[:, None], kind.p[:, None],
                     kind.chi[:, None], kind.v0[:, None], kind.mu[:, None], kind.veps[:, None]])
     return CompiledForces(forces=plane_contacts, fd=np.ascontiguousarray(fd), ix=_ints(kind.b), names=list(kind.names),
-                          what="plane contact")
+                          what="plane contact", groups=_groups(kind.b))
 
 
 __all__ = [

@@ -147,6 +147,7 @@ KERNEL_FIELDS = (
     "n_con", "con", "con_fd", "con_fo", "con_n", "con_fw", "con_ix", "con_io", "con_iw", "con_row0",
     "n_frc", "frc", "frc_fd", "frc_fo", "frc_n", "frc_fw", "frc_ix", "frc_io", "frc_iw", "frc_tab",
     "frc_jac", "frc_has_jac", "frc_acc", "frc_stateful", "st_off", "st_n", "st_w",
+    "frc_ncol", "frc_col", "frc_reach",  # column grouping of the difference Jacobian (fd_colouring)
     "mass_k", "mass_fd", "mass_ix",  # the mass kernel of the groups (a 1-tuple; a no-op without groups) and its data
 )
 
@@ -601,6 +602,7 @@ def _compile(model) -> CompiledModel:
                   rg=rg, pad_slots=pad_slots)
     kernel_fields, states = _kernel_tuples(ckinds, fkinds, mass_rec)
     fields.update(kernel_fields)
+    fields.update(zip(("frc_ncol", "frc_col", "frc_reach"), fd_colouring(fkinds, nb)))
     return CompiledModel(model, fields, ckinds, fkinds, states, mass_rec)
 
 
@@ -741,6 +743,49 @@ def _stack(blocks: list[np.ndarray], dtype) -> tuple[np.ndarray, np.ndarray, np.
     rows = np.array([b.shape[0] for b in blocks] + [0], np.int64)
     widths = np.array([b.shape[1] for b in blocks] + [0], np.int64)
     return flat, off, rows, widths
+
+
+def fd_colouring(fkinds, nb: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    r"""Column grouping of each force kind's difference Jacobian from its body groups
+    (:attr:`~core.compiled.protocol.CompiledForces.groups`).
+
+    The rows a perturbation of body ``b`` reaches are the bodies of every group holding ``b``;
+    two bodies whose reaches do not meet can be perturbed in one evaluation (Curtis, Powell & Reid
+    1974), assigned greedily in body order.  Returns ``ncol`` (KIND_CAPACITY,): the number of
+    colours, −1 for a kind without groups (every column on its own); ``col`` (KIND_CAPACITY, nb):
+    the colour of each body's columns, −1 for a body the kind does not read; ``reach``
+    (KIND_CAPACITY, nb, nb): 1 where a perturbation of body ``b`` (second index) reaches the forces
+    on body ``r`` (third).
+    """
+    n = max(nb, 1)
+    ncol = np.full(KIND_CAPACITY, -1, np.int64)
+    col = np.full((KIND_CAPACITY, n), -1, np.int64)
+    reach = np.zeros((KIND_CAPACITY, n, n), np.int64)
+    for k, rec in enumerate(fkinds):
+        if rec.groups is None:
+            continue
+        hits = [set() for _ in range(nb)]
+        for g in rec.groups:
+            bodies = [int(b) for b in np.atleast_1d(np.asarray(g, np.int64))]
+            bad = [b for b in bodies if not 0 <= b <= nb]
+            if bad:
+                raise ValueError(f"{rec.what} {rec.names[0]!r}: body group {list(bodies)} names bodies {bad} "
+                                 f"outside 0..{nb} (the layout's bodies and the ground)")
+            bodies = [b for b in bodies if b < nb]
+            for b in bodies:
+                hits[b].update(bodies)
+        used: list[set] = []
+        for b in range(nb):
+            if not hits[b]:
+                continue
+            c = next((i for i, u in enumerate(used) if not u & hits[b]), len(used))
+            if c == len(used):
+                used.append(set())
+            used[c] |= hits[b]
+            col[k, b] = c
+            reach[k, b, sorted(hits[b])] = 1
+        ncol[k] = len(used)
+    return ncol, col, reach
 
 
 def _kernel_tuples(ckinds, fkinds, mass_rec: CompiledMass | None = None) -> tuple[dict, np.ndarray]:

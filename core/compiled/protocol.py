@@ -252,6 +252,16 @@ class CompiledForces:
         ``describe_failure(state) -> str``: the cause of a failure the kind's kernels reported
         (e.g. which wheel derailed), read from its state block at the failure; appended to the
         run's message.
+    groups : list of sequences of int, optional
+        Body groups of the kind's coupling, for the difference Jacobian
+        (:func:`core.compiled.dynamics.force_jacobian`): the kind's generalized forces on the bodies
+        of a group depend on the coordinates and velocities of that group's bodies only (layout
+        body indices; the ground index is ignored), and the kind writes no force on a body outside
+        every group nor on extra coordinates.  A pair element gives the group of its two bodies;
+        the wheel–rail element one group per wheelset.  Columns whose rows do not meet are then
+        perturbed together, and the columns of bodies in no group are not perturbed at all
+        (Curtis, Powell & Reid 1974).  None: any body's coordinates may act on any force (every
+        column perturbed on its own).
     """
 
     forces: object
@@ -264,6 +274,7 @@ class CompiledForces:
     what: str = "force element"
     initial_state: object | None = None
     describe_failure: object | None = None
+    groups: list | None = None
 
 
 @dataclass

@@ -179,7 +179,7 @@ class TrackSpeedControlKind(ForceKind):
         return CompiledForces(forces=_speed_control_forces, fd=np.ascontiguousarray(fd), ix=ix,
                               names=list(self.names), accept=_speed_control_accept,
                               state=np.asarray(self._s, float)[:, None].copy(), what="track speed control",
-                              initial_state=initial_state)
+                              initial_state=initial_state, groups=[[int(b)] for b in self.b])
 
 
 @numba.njit(cache=True)

@@ -1113,6 +1113,8 @@ def compile_wheel_rail(kind, layout) -> CompiledForces:
     return CompiledForces(forces=wheel_rail_forces, fd=np.ascontiguousarray(fd), ix=np.ascontiguousarray(ix),
                           names=list(kind.names), accept=wheel_rail_accept, state=state, what="wheel-rail contact",
                           initial_state=initial_state,
+                          # the contact forces on a wheelset depend on that wheelset's state only
+                          groups=[[int(b)] for st in kind.sets for b in st.bw],
                           describe_failure=lambda stt: describe_failure(kind, stt))
 
 

@@ -244,6 +244,54 @@ def test_suspension_kernels_match_numpy_model(dim, ground):
     assert engaged == {0.0, 1.0}  # the states cover stops in and out of contact
 
 
+def test_fd_colouring_groups_columns_whose_rows_do_not_meet():
+    """Curtis–Powell–Reid grouping: a chain of pair elements 0-1, 1-2, 2-3 needs three colours
+    (bodies 0 and 3 share one), one group per body one colour, a body in no group no columns; a
+    group naming a body outside the layout is refused by name."""
+    from core.compiled.layout import fd_colouring
+
+    @dataclass
+    class Rec:
+        groups: list | None
+        what: str = "test kind"
+        names: tuple = ("e0",)
+
+    ncol, col, reach = fd_colouring([Rec([[0, 1], [1, 2], [2, 3]]), Rec([[0], [2], [3, 5]]), Rec(None)], 5)
+    assert ncol[0] == 3 and list(col[0]) == [0, 1, 2, 0, -1]
+    assert list(reach[0, 1]) == [1, 1, 1, 0, 0] and list(reach[0, 3]) == [0, 0, 1, 1, 0]
+    assert ncol[1] == 1 and list(col[1]) == [0, -1, 0, 0, -1]  # index 5 = the ground: ignored
+    assert ncol[2] == -1 and list(col[2]) == [-1] * 5
+    with pytest.raises(ValueError, match=r"test kind 'e0'.*\[7\]"):
+        fd_colouring([Rec([[0, 7]])], 5)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_grouped_differences_equal_column_by_column(dim):
+    """The differenced Jacobian by column groups (bushings, bump stops, rotational spring-dampers,
+    applied loads and plane contacts name their bodies) equals the column-by-column differences
+    of the same kernels: a group's rows do not depend on the other bodies perturbed with it, so
+    the two agree to the forward differences' round-off (ε|Q|/√ε relative)."""
+    models = [_model(dim, "revolute", seed=31 + dim, loads=True), _suspension_model(dim, seed=40 + dim)]
+    for m in models:
+        grouped, single = compile_model(m), compile_model(m)
+        assert any(n >= 0 for n in grouped.fields["frc_ncol"][:len(grouped.force_kinds)])
+        single.data.frc_ncol[:] = -1  # every column on its own
+        for seed in range(2):
+            q, v = _perturbed(m, seed)
+            out = []
+            for cm in (grouped, single):
+                ws, st = make_workspace(cm), cm.initial_states()
+                K, Dm = np.zeros((m.n_v, m.n_v)), np.zeros((m.n_v, m.n_v))
+                work = np.zeros(m.n_q), np.zeros(m.n_v), np.zeros(m.n_v), np.zeros(m.n_v)
+                assert D.force_jacobian(cm.data, st, ws, 0.37, q, v, K, Dm, *work) == P.OK
+                out.append((K, Dm))
+            Q = m.Q(0.37, q, v)
+            tol = 100 * np.finfo(float).eps / np.sqrt(np.finfo(float).eps) * max(1.0, float(np.max(np.abs(Q))))
+            assert np.max(np.abs(out[0][0] - out[1][0])) <= tol
+            assert np.max(np.abs(out[0][1] - out[1][1])) <= tol
+            assert np.max(np.abs(out[1][0])) > 0.0
+
+
 def test_qdot_retract_normalize_match_model():
     model = _model(3, "spherical", seed=4)
     lay = compile_model(model).fields["lay"]

@@ -139,27 +139,7 @@ class Spatial(Space):
     n_rot = 3
 
     def rotation(self, qb: Array) -> Array:
-        r"""``A(p̂)``, ``p̂ = p/|p|``: the rotation of the Euler parameters' direction.
-
-        The kinematic equation ``ṗ = ½ L(p)ᵀ ω̄`` keeps ``|p|`` constant, but an integrator's
-        stages and Newton iterates leave the unit sphere (a linear update is tangent to it, so
-        ``|p|² − 1`` grows with the square of the rotation in a step).  Without the normalisation
-        ``A(p)`` is not a rotation (Nikravesh 1988, Eq. 6.19 assumes ``|p| = 1``): every
-        attachment point ``A s̄`` moves by about ``(|p|² − 1) |s̄|``, and on a stiff contact that is
-        a large force along a direction the implicit integrators' velocity-space Jacobian cannot
-        see (``δθ̄ = 2 L(p) δp`` has no component along ``p``).  Measured on the Manchester coach
-        (wheelsets spinning at 22 rad/s on 1e9 N/m Hertz contacts, ``jit-radau`` at rtol 1e-4):
-        the Newton iteration stopped contracting in the wheelsets' vertical velocity (rate ≈ 1),
-        and the step fell to about 0.1 ms (9 407 steps in the first second); with ``A(p̂)``,
-        99 steps.  With ``A(p̂)`` the forces and constraints depend on the direction of ``p``
-        only, as the velocity-space formulation assumes; on the unit sphere nothing changes.
-        """
-        p = qb[:, 3:7]
-        # the arithmetic of core.compiled.dynamics.body_states, operation for operation, so that the
-        # numpy and compiled paths stay equal to the last bit
-        e0, e1, e2, e3 = p[:, 0], p[:, 1], p[:, 2], p[:, 3]
-        sn = 1.0 / np.sqrt(e0 * e0 + e1 * e1 + e2 * e2 + e3 * e3)
-        return frames.euler_to_matrix(p * sn[:, None])
+        return frames.euler_to_matrix(qb[:, 3:7])
 
     def C(self, A: Array, s: Array) -> Array:
         return -np.einsum("nij,njk->nik", A, frames.skew(s))

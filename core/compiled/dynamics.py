@@ -163,9 +163,7 @@ def body_states(lay, q, v, ws):
     """Fill ``ws.r, ws.A, ws.rd, ws.w`` in 3-D form; the ground row ``n_b`` stays at rest with A = I.
 
     Planar bodies are embedded as rotations about z: ``A = [[c, −s, 0], [s, c, 0], [0, 0, 1]]``,
-    ``ω̄ = (0, 0, θ̇)``.  Spatial: ``A(p̂)`` of the normalised Euler parameters ``p̂ = p/|p|``
-    (Nikravesh 1988, Eq. 6.19, which assumes ``|p| = 1``): every rotation a model sees depends on
-    the direction of ``p`` only (see :meth:`core.bodies.Spatial.rotation` for why).
+    ``ω̄ = (0, 0, θ̇)``.  Spatial: ``A(p)`` of the Euler parameters (Nikravesh 1988, Eq. 6.19).
     """
     _body_states(lay, q, v, ws.r, ws.A, ws.rd, ws.w)
 
@@ -191,8 +189,6 @@ def _body_states(lay, q, v, r, A, rd, w):
         for b in range(nb):
             o = 7 * b
             e0, e1, e2, e3 = q[o + 3], q[o + 4], q[o + 5], q[o + 6]
-            sn = 1.0 / np.sqrt(e0 * e0 + e1 * e1 + e2 * e2 + e3 * e3)  # A(p/|p|)
-            e0, e1, e2, e3 = e0 * sn, e1 * sn, e2 * sn, e3 * sn
             r[b, 0], r[b, 1], r[b, 2] = q[o], q[o + 1], q[o + 2]
             A[b, 0, 0] = 2.0 * (e0 * e0 + e1 * e1) - 1.0
             A[b, 0, 1] = 2.0 * (e1 * e2 - e0 * e3)

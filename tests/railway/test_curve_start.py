@@ -16,11 +16,7 @@ from railway.track import Curve, Straight, Track, Transition
 from railway.vehicles.vehicle import GRAVITY, VehicleDefinition, build_vehicle
 from railway.vehicles.wheel_rail import contact_history
 
-# rtol 1e-5: since the rotation matrix ignores |p| (core.bodies.Spatial.rotation), jit-dop853 is no
-# longer held to short steps by the off-sphere stages, and at rtol 1e-4 its own error, 6.7 N of a wheel
-# load in 123 steps (1.2e-4 of m g / 8), is as large as the drift bound; at 1e-5 (181 steps, fewer than
-# the 324 of rtol 1e-4 before) 0.2 N, so that the bound tests the start state, not the tolerance
-RADIUS, V, RTOL, T_RUN = 200.0, 20.0, 1e-5, 0.3
+RADIUS, V, RTOL, T_RUN = 200.0, 20.0, 1e-4, 0.3
 
 
 @pytest.fixture(scope="module")
@@ -159,8 +155,7 @@ def test_a_run_started_in_the_curve_stays_in_the_quasi_static_state(starts, key)
     scale = coach_weight_share(veh)
     # drift bounds from the integrator's tolerance: every force within rtol of the wheel load's
     # scale m g / 8, every displacement and yaw within rtol of 10 mm / 10 mrad (measured over
-    # 0.3 s at rtol 1e-4 before the rotation matrix ignored |p|: forces 7e-6 of m g / 8, i.e. 0.4 N;
-    # displacements 6e-11 m, yaw 3e-11 rad)
+    # 0.3 s: forces 7e-6 of m g / 8, i.e. 0.4 N; displacements 6e-11 m, yaw 3e-11 rad)
     dQ = (g["Q [N]"].max() - g["Q [N]"].min()).max()
     dY = (g["Y [N]"].max() - g["Y [N]"].min()).max()
     assert dQ <= RTOL * scale and dY <= RTOL * scale, (dQ, dY)

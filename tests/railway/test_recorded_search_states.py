@@ -67,8 +67,7 @@ def test_the_replay_with_the_recorded_states_agrees_with_the_carried_search(run)
 def coach_run():
     from railway.vehicles.curving import run_curving
 
-    # 0.7 s: more accepted steps than one batch of ROW_BATCH rows (about 300)
-    res, veh = run_curving("polach2000", 20.0, T=0.7, record_steps=True)
+    res, veh = run_curving("polach2000", 20.0, T=0.25, record_steps=True)
     assert res.status == "finished", res.message
     return veh.model, res
 

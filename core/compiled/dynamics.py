@@ -926,6 +926,34 @@ def project(cd, ws, t, q, v, tol, max_iter, counters):
 
 
 @_jit
+def _kind_forces(cd, states, ws, k, t, q, v, Q):
+    """``Q`` ← the generalized forces of force kind ``k`` alone at ``(t, q, v)``; status (a kernel
+    failure names the kind in ``ws.err``)."""
+    for i in range(Q.shape[0]):
+        Q[i] = 0.0
+    body_states(cd.lay, q, v, ws)
+    st = cd.frc[k](t, q, v, ws.r, ws.A, ws.rd, ws.w, cd.lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k), Q, ws.err)
+    if st != OK:
+        ws.err[0] = k
+        ws.err[2] = 1
+    return st
+
+
+@_jit
+def _add_group_differences(M, col, reach, c, d, nb, nvb, Qa, Qb, eps, v, velocity):
+    """Columns ``nvb b + d`` of the bodies ``b`` of colour ``c``: ``(Qb − Qa)/h`` on the rows their
+    perturbation reaches, ``h = √ε`` (positions) or ``√ε max(1, |v_j|)`` (``velocity``)."""
+    for b in range(nb):
+        if col[b] == c:
+            j = nvb * b + d
+            h = eps * max(1.0, abs(v[j])) if velocity else eps
+            for rb in range(nb):
+                if reach[b, rb]:
+                    for i in range(nvb * rb, nvb * rb + nvb):
+                        M[i, j] += (Qb[i] - Qa[i]) / h
+
+
+@_jit
 def _grouped_differences(cd, states, ws, k, t, q, v, K, D, qp, vp, Qa, Qb, eps):
     r"""Forward differences of kind ``k``'s forces (``Qa`` at ``(q, v)``) by column groups
     (:func:`core.compiled.layout.fd_colouring`): per colour and per body freedom ``d`` one
@@ -945,45 +973,20 @@ def _grouped_differences(cd, states, ws, k, t, q, v, K, D, qp, vp, Qa, Qb, eps):
                 if col[b] == c:
                     vp[nvb * b + d] = eps
             retract(lay, qp, vp)
-            for i in range(n_v):
-                Qb[i] = 0.0
-            body_states(lay, qp, v, ws)
-            st = cd.frc[k](t, qp, v, ws.r, ws.A, ws.rd, ws.w, lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k), Qb,
-                           ws.err)
+            st = _kind_forces(cd, states, ws, k, t, qp, v, Qb)
             if st != OK:
-                ws.err[0] = k
-                ws.err[2] = 1
                 return st
-            for b in range(nb):
-                if col[b] == c:
-                    j = nvb * b + d
-                    for rb in range(nb):
-                        if reach[b, rb]:
-                            for i in range(nvb * rb, nvb * rb + nvb):
-                                K[i, j] += (Qb[i] - Qa[i]) / eps
+            _add_group_differences(K, col, reach, c, d, nb, nvb, Qa, Qb, eps, v, False)
             for i in range(n_v):
                 vp[i] = v[i]
             for b in range(nb):
                 if col[b] == c:
                     j = nvb * b + d
                     vp[j] += eps * max(1.0, abs(v[j]))
-            for i in range(n_v):
-                Qb[i] = 0.0
-            body_states(lay, q, vp, ws)
-            st = cd.frc[k](t, q, vp, ws.r, ws.A, ws.rd, ws.w, lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k), Qb,
-                           ws.err)
+            st = _kind_forces(cd, states, ws, k, t, q, vp, Qb)
             if st != OK:
-                ws.err[0] = k
-                ws.err[2] = 1
                 return st
-            for b in range(nb):
-                if col[b] == c:
-                    j = nvb * b + d
-                    h = eps * max(1.0, abs(v[j]))
-                    for rb in range(nb):
-                        if reach[b, rb]:
-                            for i in range(nvb * rb, nvb * rb + nvb):
-                                D[i, j] += (Qb[i] - Qa[i]) / h
+            _add_group_differences(D, col, reach, c, d, nb, nvb, Qa, Qb, eps, v, True)
     return OK
 
 
@@ -1035,14 +1038,8 @@ def force_jacobian(cd, states, ws, t, q, v, K, D, qp, vp, Qa, Qb):
                 return st
             continue
         # forward differences of this kind's forces
-        for i in range(n_v):
-            Qa[i] = 0.0
-        body_states(lay, q, v, ws)
-        st = cd.frc[k](t, q, v, ws.r, ws.A, ws.rd, ws.w, lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k), Qa,
-                       ws.err)
+        st = _kind_forces(cd, states, ws, k, t, q, v, Qa)
         if st != OK:
-            ws.err[0] = k
-            ws.err[2] = 1
             return st
         if cd.frc_ncol[k] >= 0:
             st = _grouped_differences(cd, states, ws, k, t, q, v, K, D, qp, vp, Qa, Qb, eps)
@@ -1057,14 +1054,8 @@ def force_jacobian(cd, states, ws, t, q, v, K, D, qp, vp, Qa, Qb):
             h = eps
             vp[j] = h
             retract(lay, qp, vp)
-            body_states(lay, qp, v, ws)
-            for i in range(n_v):
-                Qb[i] = 0.0
-            st = cd.frc[k](t, qp, v, ws.r, ws.A, ws.rd, ws.w, lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k), Qb,
-                           ws.err)
+            st = _kind_forces(cd, states, ws, k, t, qp, v, Qb)
             if st != OK:
-                ws.err[0] = k
-                ws.err[2] = 1
                 return st
             for i in range(n_v):
                 K[i, j] += (Qb[i] - Qa[i]) / h
@@ -1072,14 +1063,8 @@ def force_jacobian(cd, states, ws, t, q, v, K, D, qp, vp, Qa, Qb):
                 vp[i] = v[i]
             h = eps * max(1.0, abs(v[j]))
             vp[j] += h
-            body_states(lay, q, vp, ws)
-            for i in range(n_v):
-                Qb[i] = 0.0
-            st = cd.frc[k](t, q, vp, ws.r, ws.A, ws.rd, ws.w, lay, _ffd(cd, k), _fix(cd, k), _fst(cd, states, k), Qb,
-                           ws.err)
+            st = _kind_forces(cd, states, ws, k, t, q, vp, Qb)
             if st != OK:
-                ws.err[0] = k
-                ws.err[2] = 1
                 return st
             for i in range(n_v):
                 D[i, j] += (Qb[i] - Qa[i]) / h

@@ -766,7 +766,10 @@ def fd_colouring(fkinds, nb: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             continue
         hits = [set() for _ in range(nb)]
         for g in rec.groups:
-            bodies = [int(b) for b in np.atleast_1d(np.asarray(g, np.int64))]
+            if np.ndim(g) != 1:
+                raise ValueError(f"{rec.what} {rec.names[0]!r}: each body group must be a sequence of body "
+                                 f"indices, got {g!r} (groups=[[0, 1], [2]], not [0, 1, 2])")
+            bodies = [int(b) for b in np.asarray(g, np.int64)]
             bad = [b for b in bodies if not 0 <= b <= nb]
             if bad:
                 raise ValueError(f"{rec.what} {rec.names[0]!r}: body group {list(bodies)} names bodies {bad} "

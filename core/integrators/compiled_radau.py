@@ -73,7 +73,7 @@ a large force along a direction the velocity-space iteration matrix cannot conta
 the Manchester coach (wheelsets spinning at 22 rad/s on 1e9 N/m Hertz contacts, rtol 1e-4): without
 the normalisation the largest Newton increment sat in the leading wheelset's vertical velocity with
 rate ≈ 1, also with a fresh Jacobian at every step, and the step fell to 0.1 ms (9 407 steps in the
-first second, 6 s in 16.8 s); with it, 99 steps in the first second and 6 s in 2.2 s, without a
+first second, 6 s in 16.8 s); with it, 102 steps in the first second and 6 s in 2.2 s, without a
 stability limit.  The explicit integrators evaluate the model as it is (their step control sees
 the off-sphere sensitivity as stiffness; the docs' benchmarks page has what changed when the model
 itself used ``A(p/|p|)``).

@@ -263,6 +263,8 @@ def test_fd_colouring_groups_columns_whose_rows_do_not_meet():
     assert ncol[2] == -1 and list(col[2]) == [-1] * 5
     with pytest.raises(ValueError, match=r"test kind 'e0'.*\[7\]"):
         fd_colouring([Rec([[0, 7]])], 5)
+    with pytest.raises(ValueError, match=r"test kind 'e0'.*sequence of body indices, got 0"):
+        fd_colouring([Rec([0, 1])], 5)  # a flat list is not two groups
 
 
 @pytest.mark.parametrize("dim", [2, 3])

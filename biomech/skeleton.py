@@ -167,8 +167,26 @@ def axis_rotation(axis, angle) -> np.ndarray:
 
 
 def _cross_columns(vectors: np.ndarray, columns: np.ndarray) -> np.ndarray:
-    """``columns[..., :, j] × vectors`` for every column j: (n, 3, k) × (n, 3) -> (n, 3, k)."""
-    return np.cross(columns, vectors[:, :, None], axisa=1, axisb=1, axisc=1)
+    """``columns[..., :, j] × vectors`` for every column j: (n, 3, k) × (n, 3) -> (n, 3, k).
+
+    Written out by components: ``np.cross`` with axis arguments spends most of its time moving
+    axes on arrays this small (the products and their order are those of ``np.cross``)."""
+    c0, c1, c2 = columns[:, 0], columns[:, 1], columns[:, 2]
+    v0, v1, v2 = vectors[:, 0, None], vectors[:, 1, None], vectors[:, 2, None]
+    out = np.empty(columns.shape)
+    out[:, 0] = c1 * v2 - c2 * v1
+    out[:, 1] = c2 * v0 - c0 * v2
+    out[:, 2] = c0 * v1 - c1 * v0
+    return out
+
+
+def _cross_last(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a × b`` along the last axis (length 3), by components as :func:`_cross_columns`."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
 
 
 # =============================================================================================
@@ -922,10 +940,13 @@ class Skeleton:
         F = np.zeros((n, self.n_muscles * nf, 3))
         M = np.zeros((n, self.n_muscles * nf, 3))
         np.add.at(F, (slice(None), key), g)
-        np.add.at(M, (slice(None), key), np.cross(rho, g))
+        np.add.at(M, (slice(None), key), _cross_last(rho, g))
         F = F.reshape(n, self.n_muscles, nf, 3)
         M = M.reshape(n, self.n_muscles, nf, 3)
-        dLdq = np.einsum("nmbi,nbij->nmj", F, Jx) + np.einsum("nmbi,nbij->nmj", M, Jw)
+        # Σ_b,i F_mbi Jx_bij + M_mbi Jw_bij, one batched product per frame (einsum loops over it)
+        nq = self.n_coordinates
+        dLdq = (F.reshape(n, self.n_muscles, 3 * nf) @ Jx.reshape(n, 3 * nf, nq)
+                + M.reshape(n, self.n_muscles, 3 * nf) @ Jw.reshape(n, 3 * nf, nq))
         for p, k, c, dd in dloc:
             col = R[:, pt.body[p], :, k]          # ∂(R s)/∂s_k
             dLdq[:, pt.muscle[p], c] += np.einsum("ni,ni->n", g[:, p], col) * dd

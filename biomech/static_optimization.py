@@ -706,6 +706,20 @@ class StaticOptimization:
         reason = self._check_frame(R, A, P, tau)
         if reason:
             return self._empty("invalid_input", reason, 0.0)
+        a, u, status, message, elapsed, solver_time, iters = self._attempts(R, A, P, tau)
+        if a is None:
+            sol = self._empty(status, message or "no solution", elapsed)
+            sol.solver_time, sol.iterations = solver_time, iters
+            return sol
+        forces = A * a + P
+        reserve_forces = self.reserve_optimal_force * u
+        residual = R @ forces + self.G @ u - tau
+        return FrameSolution(a, forces, u, reserve_forces, residual, status, message,
+                             self.objective_value(a, u, A, P), elapsed, solver_time, iters)
+
+    def _attempts(self, R, A, P, tau):
+        """The attempts of one checked frame (first, retries, least deficit): (a, u, status,
+        message, wall time, Clarabel time, iterations), ``a`` and ``u`` None without solution."""
         t0 = time.perf_counter()
         values = {self._B: R * A, self._b: tau - R @ P}  # R diag(A), τ − R P
         if self._c is not None:
@@ -743,16 +757,7 @@ class StaticOptimization:
             a = u = None
             if status != "solver_error":
                 message = f"solver status {status!r}; {message}".rstrip("; ")
-        elapsed = time.perf_counter() - t0
-        if a is None:
-            sol = self._empty(status, message or "no solution", elapsed)
-            sol.solver_time, sol.iterations = solver_time, iters
-            return sol
-        forces = A * a + P
-        reserve_forces = self.reserve_optimal_force * u
-        residual = R @ forces + self.G @ u - tau
-        return FrameSolution(a, forces, u, reserve_forces, residual, status, message,
-                             self.objective_value(a, u, A, P), elapsed, solver_time, iters)
+        return a, u, status, message, time.perf_counter() - t0, solver_time, iters
 
     @staticmethod
     def _set_parameters(values):
@@ -873,29 +878,54 @@ class StaticOptimization:
                                   ("passive_force", P, (nf, n)), ("generalized_forces", tau, (nf, m))):
             if arr.shape != shape:
                 raise InputError(f"{label} must have shape {shape} (n_frames, ...), got {arr.shape}")
-        sols = [self._solve(R[k], A[k], P[k], tau[k]) for k in range(nf)]
+        # the frames' data checked all at once; a frame that fails gets its reason from the
+        # per-frame check (the same message as solve_frame)
+        usable = (np.isfinite(R).all(axis=(1, 2)) & np.isfinite(A).all(axis=1) & np.isfinite(P).all(axis=1)
+                  & np.isfinite(tau).all(axis=1) & ~(A < 0).any(axis=1))
+        if self.criterion == "stress":
+            usable &= ~(P < 0).any(axis=1)
+        nr = self.n_reserves
+        acts, ctrl = np.full((nf, n), np.nan), np.full((nf, nr), np.nan)
+        status, message = [""] * nf, [""] * nf
+        elapsed, solver_time = np.zeros(nf), np.full(nf, np.nan)
+        iters = np.full(nf, -1, dtype=int)
+        for k in range(nf):
+            reason = "" if usable[k] else self._check_frame(R[k], A[k], P[k], tau[k])
+            if reason:
+                status[k], message[k] = "invalid_input", reason
+                continue
+            a, u, status[k], msg, elapsed[k], solver_time[k], iters[k] = self._attempts(R[k], A[k], P[k], tau[k])
+            if a is None:
+                message[k] = msg or "no solution"
+            else:
+                acts[k], ctrl[k], message[k] = a, u, msg
+        # forces, residuals and criterion of all frames at once (as solve_frame computes them)
+        forces = A * acts + P
+        rf = self.reserve_optimal_force * ctrl
+        residual = np.einsum("kmn,kn->km", R, forces) + ctrl @ self.G.T - tau
+        finite = np.isfinite(residual).all(axis=1)
+        max_res = np.where(finite, np.abs(np.where(finite[:, None], residual, 0.0)).max(axis=1, initial=0.0), np.nan)
+        x = acts if self.criterion == "activation" else (A * acts + P) / self.stress_force_scale
+        p = self.exponent
+        objective = np.sum(np.abs(x) ** p, axis=1) + self.reserve_weight * np.sum(np.abs(ctrl) ** p, axis=1)
 
         unit_set = sorted(set(self.coordinate_units))
         res_unit = unit_set[0] if len(unit_set) == 1 else " or ".join(unit_set)
         cols: dict[str, object] = {"time [s]": t}
-        acts = np.array([s.activations for s in sols]).reshape(nf, n)
-        forces = np.array([s.forces for s in sols]).reshape(nf, n)
         for j, name in enumerate(self.muscle_names):
             cols[f"a_{name} [-]"] = acts[:, j]
         for j, name in enumerate(self.muscle_names):
             cols[f"F_{name} [N]"] = forces[:, j]
-        ctrl = np.array([s.reserve_controls for s in sols]).reshape(nf, self.n_reserves)
-        rf = np.array([s.reserve_forces for s in sols]).reshape(nf, self.n_reserves)
         for k, (i, name) in enumerate(zip(self.reserve_index, self.reserve_coordinates)):
             cols[f"u_{name} [-]"] = ctrl[:, k]
             cols[f"reserve_{name} [{self.coordinate_units[i]}]"] = rf[:, k]
-        cols[f"max |R F + r - tau| [{res_unit}]"] = np.array([s.max_residual for s in sols])
-        cols["status"] = [s.status for s in sols]
-        cols["message"] = [s.message for s in sols]
-        cols["objective [-]"] = np.array([s.objective for s in sols])
-        cols["solve time [s]"] = np.array([s.solve_time for s in sols])
-        cols["solver time [s]"] = np.array([s.solver_time for s in sols])
-        cols["iterations"] = np.array([s.iterations for s in sols], dtype=int)
+        cols[f"max |R F + r - tau| [{res_unit}]"] = max_res
+        cols["status"] = status
+        cols["message"] = message
+        cols["objective [-]"] = objective
+        cols["solve time [s]"] = elapsed
+        cols["solver time [s]"] = solver_time
+        cols["iterations"] = iters
         df = pd.DataFrame(cols)
         counts = df["status"].value_counts()
         df.attrs.update({

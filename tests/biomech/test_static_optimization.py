@@ -323,6 +323,38 @@ def test_infeasible_frame_reported_and_trial_continues():
     assert df.attrs["status_counts"] == {"optimal": 4, "infeasible": 1, "invalid_input": 1}
 
 
+@pytest.mark.parametrize("criterion", ["activation", "stress"])
+def test_trial_table_equals_frame_by_frame(criterion):
+    """solve_trial checks the frames and forms forces, residuals and criterion for all frames at
+    once; every row equals solve_frame of that frame (optimal, infeasible and invalid frames)."""
+    rng = np.random.default_rng(11)
+    muscles, coords, pattern = synthetic_model(rng, 3, 6)
+    R, A, P, tau = synthetic_frames(rng, muscles, pattern, 6)
+    capacity = np.where(R[1] > 0, R[1] * (A[1] + P[1]), R[1] * P[1]).sum(axis=1)
+    tau[1, 2] = 3.0 * capacity[2]                  # infeasible without reserves
+    A[3, 4] = -5.0                                 # invalid: negative active force
+    R[4, 0, 1] = np.inf                            # invalid: non-finite moment arm
+    P[5, 0] = -1.0                                 # invalid for the stress criterion only
+    so = StaticOptimization.from_muscles(muscles, coords, criterion=criterion)
+    df = so.solve_trial(np.arange(6) * 0.01, R, A, P, tau)
+    res_col = "max |R F + r - tau| [N m]"
+    # each row and solve_frame are separate interior-point solves (the direct route or cvxpy's),
+    # equal to Clarabel's tolerances (1e-8): activations to 1e-7, forces to 1e-7 F0
+    for k in range(6):
+        f = so.solve_frame(R[k], A[k], P[k], tau[k])
+        row = df.loc[k]
+        assert row["status"] == f.status and row["message"] == f.message, k
+        np.testing.assert_allclose(row[[f"a_{m} [-]" for m in so.muscle_names]].to_numpy(float), f.activations,
+                                   rtol=0, atol=1e-7)
+        np.testing.assert_allclose(row[[f"F_{m} [N]" for m in so.muscle_names]].to_numpy(float), f.forces,
+                                   rtol=0, atol=1e-7 * float(np.max(muscles.max_isometric_force)))
+        np.testing.assert_allclose(row[res_col], f.max_residual, rtol=1e-6, atol=1e-6)
+        np.testing.assert_allclose(row["objective [-]"], f.objective, rtol=1e-6, atol=1e-9)
+    assert list(df["status"][3:5]) == ["invalid_input"] * 2
+    assert df["status"][1] == "infeasible"
+    assert (df["status"][5] == "invalid_input") == (criterion == "stress")
+
+
 def test_least_deficit_closed_form():
     """One coordinate, all moment arms positive, tau beyond capacity: all muscles at a = 1."""
     so = StaticOptimization(["a", "b", "c"], ["knee"], [1000.0, 2000.0, 500.0])

@@ -840,7 +840,7 @@ class CompiledRadau(Integrator):
         self._cd = cm.data
         self._states = cm.initial_states()
         self._ws = _d.make_workspace(cm)
-        notify_if_cold(advance, self.name, "about 32 s, 16 s after a jit-dop853 or jit-rk45")
+        notify_if_cold(advance, self.name, "30-70 s, 15-35 s after a jit-dop853 or jit-rk45")
         self.alpha = self.beta = 0.0
         if self.stabilization == "baumgarte":
             self.alpha = float(o.get("alpha", DEFAULT_BAUMGARTE))

@@ -464,7 +464,7 @@ class CompiledRK(Integrator):
         self._cd = self._cm.data
         self._states = self._cm.initial_states()
         self._ws = _d.make_workspace(self._cm)
-        notify_if_cold(advance, self.name, "about 19 s")
+        notify_if_cold(advance, self.name, "20-40 s")
         self.alpha = self.beta = 0.0
         if self.stabilization == "baumgarte":
             self.alpha = float(o.get("alpha", DEFAULT_BAUMGARTE))

@@ -296,8 +296,8 @@ def main(argv=None):
     load0 = os.getloadavg()[0]
     cal = calibrate()
     wp = with_calibration(work_precision(args.quick), cal, ["wall time [s]"])
-    # jit-radau beside jit-dop853: since the rotation matrix ignores |p| it runs the coach without the
-    # stability warning (docs/benchmarks.md, issue 24)
+    # jit-radau beside jit-dop853: with its stages' Euler parameters on the unit sphere it runs the
+    # coach without the stability warning (core.integrators.compiled_radau, docs/benchmarks.md, issue 24)
     rt = with_calibration(pd.DataFrame([real_time(), real_time("jit-radau")]), cal, ["wall time, integration [s]"])
     acc = accuracy_against_speed()
     acc = with_calibration(acc, cal, ["wall time, integration [s]"])

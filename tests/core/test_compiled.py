@@ -275,18 +275,23 @@ def test_grouped_differences_equal_column_by_column(dim):
     the two agree to the forward differences' round-off (ε|Q|/√ε relative)."""
     models = [_model(dim, "revolute", seed=31 + dim, loads=True), _suspension_model(dim, seed=40 + dim)]
     for m in models:
-        grouped, single = compile_model(m), compile_model(m)
-        assert any(n >= 0 for n in grouped.fields["frc_ncol"][:len(grouped.force_kinds)])
-        single.data.frc_ncol[:] = -1  # every column on its own
+        # compile_model caches per model: one packed model, its colouring switched off and back
+        cm = compile_model(m)
+        grouped = cm.data.frc_ncol.copy()
+        assert any(n >= 0 for n in grouped[:len(cm.force_kinds)])
         for seed in range(2):
             q, v = _perturbed(m, seed)
             out = []
-            for cm in (grouped, single):
-                ws, st = make_workspace(cm), cm.initial_states()
-                K, Dm = np.zeros((m.n_v, m.n_v)), np.zeros((m.n_v, m.n_v))
-                work = np.zeros(m.n_q), np.zeros(m.n_v), np.zeros(m.n_v), np.zeros(m.n_v)
-                assert D.force_jacobian(cm.data, st, ws, 0.37, q, v, K, Dm, *work) == P.OK
-                out.append((K, Dm))
+            try:
+                for ncol in (grouped, -1):  # by column groups, then every column on its own
+                    cm.data.frc_ncol[:] = ncol
+                    ws, st = make_workspace(cm), cm.initial_states()
+                    K, Dm = np.zeros((m.n_v, m.n_v)), np.zeros((m.n_v, m.n_v))
+                    work = np.zeros(m.n_q), np.zeros(m.n_v), np.zeros(m.n_v), np.zeros(m.n_v)
+                    assert D.force_jacobian(cm.data, st, ws, 0.37, q, v, K, Dm, *work) == P.OK
+                    out.append((K, Dm))
+            finally:
+                cm.data.frc_ncol[:] = grouped
             Q = m.Q(0.37, q, v)
             tol = 100 * np.finfo(float).eps / np.sqrt(np.finfo(float).eps) * max(1.0, float(np.max(np.abs(Q))))
             assert np.max(np.abs(out[0][0] - out[1][0])) <= tol

@@ -286,6 +286,44 @@ def test_static_preload_deflections_are_those_of_the_springs(coach):
     assert np.max(np.abs(parking["My [N m]"])) < 1e-3
 
 
+def test_wheel_rail_difference_jacobian_by_wheelset_groups_equals_column_by_column(coach):
+    """The compiled wheel-rail kind names one body group per wheelset (its forces on a wheelset
+    depend on that wheelset's state alone) and the track speed control one per body: the
+    difference Jacobian with the four wheelsets perturbed together equals the column-by-column
+    one to the forward differences' round-off (ε|Q|/√ε relative), on the coach in contact."""
+    from core.compiled import dynamics as D
+    from core.compiled import protocol as P
+    from core.compiled.layout import compile_model
+
+    veh, _ = coach
+    m = veh.model
+    q, v = veh.initial_state()
+    v = v.copy()
+    rng = np.random.default_rng(3)
+    v += 0.02 * rng.standard_normal(v.shape)  # creepage in every direction on every wheel
+    m.begin_run(0.0, q, v)
+    cm = compile_model(m)  # cached per model: its colouring is switched off and back
+    k = [r.what for r in cm.force_kinds].index("wheel-rail contact")
+    grouped = cm.data.frc_ncol.copy()
+    assert grouped[k] == 1  # the four wheelsets share nothing: one colour
+    out = []
+    try:
+        for ncol in (grouped, -1):  # by column groups, then every column on its own
+            cm.data.frc_ncol[:] = ncol
+            ws, st = D.make_workspace(cm), cm.initial_states()
+            K, Dm = np.zeros((m.n_v, m.n_v)), np.zeros((m.n_v, m.n_v))
+            work = np.zeros(m.n_q), np.zeros(m.n_v), np.zeros(m.n_v), np.zeros(m.n_v)
+            assert D.force_jacobian(cm.data, st, ws, 0.0, q, v, K, Dm, *work) == P.OK
+            out.append((K, Dm))
+    finally:
+        cm.data.frc_ncol[:] = grouped
+    Q = m.Q(0.0, q, v)
+    tol = 100 * np.finfo(float).eps / np.sqrt(np.finfo(float).eps) * float(np.max(np.abs(Q)))
+    assert np.max(np.abs(out[1][0])) > 1e6  # the contact stiffness is in it
+    assert np.max(np.abs(out[0][0] - out[1][0])) <= tol
+    assert np.max(np.abs(out[0][1] - out[1][1])) <= tol
+
+
 def test_vehicle_file_errors_name_the_file_and_key(tmp_path):
     from core.errors import DataFileError
 

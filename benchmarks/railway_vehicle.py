@@ -9,11 +9,11 @@
    long curve so that 30 s at 10 m/s stay in it) with the recommended integrator, and where the
    time goes: right-hand sides (contact kernel and the rest) and accepted-step updates, each
    kernel timed in a compiled loop (no Python call in the timing).
-3. Real-time factor against accuracy on the same 30 s: jit-dop853 at rtol 1e-3 and 1e-4, each
-   against a reference at rtol 1e-7: the leading wheelset's lateral displacement at every output
+3. Real-time factor against accuracy on the same 30 s: jit-dop853 and jit-radau at rtol 1e-3 and
+   1e-4, each against a reference at rtol 1e-7: the leading wheelset's lateral displacement at every output
    and the quasi-static curving values (the scene's table: means per wheel while the whole
-   vehicle is in the full curve, 30 m from both transitions); and the same with the cross-section
-   scan every 5 accepted steps instead of every step (a trade-off the scenes do not take: between
+   vehicle is in the full curve, 30 m from both transitions); and, for jit-dop853, the same with
+   the cross-section scan every 5 accepted steps instead of every step (a trade-off the scenes do not take: between
    two scans a new contact is not searched for, so the force at a state depends on when the last
    scan was).
 4. The flying wheelset and the linear critical-speed sweep, timed.
@@ -195,8 +195,9 @@ def _full_curve_means(H, curve_length):
 
 
 def accuracy_against_speed(V=10.0, T=30.0, rtols=(1e-3, 1e-4), reseeds=(1, 5), rtol_ref=1e-7):
-    """Real-time factor and error of jit-dop853 on the 30 s run at each tolerance (module
-    docstring, item 3): one row per (rtol, scan every N accepted steps)."""
+    """Real-time factor and error of jit-dop853 and jit-radau on the 30 s run at each tolerance
+    (module docstring, item 3): one row per (method, rtol, scan every N accepted steps); jit-radau
+    with the scenes' scan at every accepted step only."""
     from core.integrators import simulate
     from railway.vehicles.curving import curving_track
     from railway.vehicles.curving import run_curving
@@ -210,15 +211,17 @@ def accuracy_against_speed(V=10.0, T=30.0, rtols=(1e-3, 1e-4), reseeds=(1, 5), r
     ws0 = veh.wheelsets[0]
     y_ref = ref.coordinates()[f"{ws0}.y [m]"].to_numpy()
     rows = []
-    for reseed in reseeds:
+    cases = [("jit-dop853", reseed) for reseed in reseeds] + [("jit-radau", 1)]
+    for method, reseed in cases:
         for rtol in rtols:
-            _, veh = run_curving("polach2000", V, T=0.05, track=track, rtol=rtol, reseed_every=reseed)
+            _, veh = run_curving("polach2000", V, T=0.05, track=track, method=method, rtol=rtol,
+                                 reseed_every=reseed)
             q0, v0 = veh.initial_state()
             t0 = time.perf_counter()
-            res = simulate(veh.model, (0.0, T), "jit-dop853", q0=q0, v0=v0, rtol=rtol, atol=rtol * 1e-2,
+            res = simulate(veh.model, (0.0, T), method, q0=q0, v0=v0, rtol=rtol, atol=rtol * 1e-2,
                            n_output=int(T * 10) + 1)
             wall = time.perf_counter() - t0
-            row = {"rtol": rtol, "scan every N accepted steps": reseed, "status": res.status,
+            row = {"method": method, "rtol": rtol, "scan every N accepted steps": reseed, "status": res.status,
                    "wall time, integration [s]": wall, "real-time factor [-]": T / wall,
                    "steps": res.counters["n_steps"]}
             if res.success:

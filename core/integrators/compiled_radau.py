@@ -231,7 +231,8 @@ def _new_radau_work(*values):
 
 @_internal
 def _orientation(e0, e1, e2, e3, A):
-    """``A(p)`` (Nikravesh 1988, Eq. 6.19) into ``A``."""
+    """``A(p)`` (Nikravesh 1988, Eq. 6.19) into ``A`` for one set of Euler parameters (a stage's;
+    :func:`core.compiled.dynamics.body_states` writes the same for every body of a state)."""
     A[0, 0] = 2.0 * (e0 * e0 + e1 * e1) - 1.0
     A[1, 1] = 2.0 * (e0 * e0 + e2 * e2) - 1.0
     A[2, 2] = 2.0 * (e0 * e0 + e3 * e3) - 1.0
@@ -593,11 +594,12 @@ def _jacobian(cd, states, ws, rw, t, q, v, h):
     act = cd.act
     m = act.shape[0]
     nv = rw.K.shape[0]
-    if spatial_model:  # the orientations the Jacobian belongs to (_frames)
-        for bb in range(cd.lay[0]):
-            o = 7 * bb + 3
-            _orientation(q[o], q[o + 1], q[o + 2], q[o + 3], rw.AJ[bb])
     _d.body_states(cd.lay, q, v, ws)
+    if spatial_model:  # the orientations the Jacobian belongs to (_frames): A(p) of body_states
+        for bb in range(cd.lay[0]):
+            for i in range(3):
+                for j in range(3):
+                    rw.AJ[bb, i, j] = ws.A[bb, i, j]
     if cd.n_grp:  # the mass groups' blocks of M at this state (the rest of M is constant)
         st = _d.mass_update(cd, ws, t, q, v)
         if st != _p.OK:

@@ -267,6 +267,25 @@ def test_fd_colouring_groups_columns_whose_rows_do_not_meet():
         fd_colouring([Rec([0, 1])], 5)  # a flat list is not two groups
 
 
+def grouped_and_column_jacobians(cm, m, t, q, v):
+    """``[(K, D) by column groups, (K, D) column by column]`` of the compiled force Jacobian at
+    ``(t, q, v)``.  ``compile_model`` caches per model, so both come from the one packed model:
+    its colouring ``frc_ncol`` is switched off for the second and always restored."""
+    grouped = cm.data.frc_ncol.copy()
+    out = []
+    try:
+        for ncol in (grouped, -1):  # by column groups, then every column on its own
+            cm.data.frc_ncol[:] = ncol
+            ws, st = make_workspace(cm), cm.initial_states()
+            K, Dm = np.zeros((m.n_v, m.n_v)), np.zeros((m.n_v, m.n_v))
+            work = np.zeros(m.n_q), np.zeros(m.n_v), np.zeros(m.n_v), np.zeros(m.n_v)
+            assert D.force_jacobian(cm.data, st, ws, t, q, v, K, Dm, *work) == P.OK
+            out.append((K, Dm))
+    finally:
+        cm.data.frc_ncol[:] = grouped
+    return out
+
+
 @pytest.mark.parametrize("dim", [2, 3])
 def test_grouped_differences_equal_column_by_column(dim):
     """The differenced Jacobian by column groups (bushings, bump stops, rotational spring-dampers,
@@ -281,17 +300,8 @@ def test_grouped_differences_equal_column_by_column(dim):
         assert any(n >= 0 for n in grouped[:len(cm.force_kinds)])
         for seed in range(2):
             q, v = _perturbed(m, seed)
-            out = []
-            try:
-                for ncol in (grouped, -1):  # by column groups, then every column on its own
-                    cm.data.frc_ncol[:] = ncol
-                    ws, st = make_workspace(cm), cm.initial_states()
-                    K, Dm = np.zeros((m.n_v, m.n_v)), np.zeros((m.n_v, m.n_v))
-                    work = np.zeros(m.n_q), np.zeros(m.n_v), np.zeros(m.n_v), np.zeros(m.n_v)
-                    assert D.force_jacobian(cm.data, st, ws, 0.37, q, v, K, Dm, *work) == P.OK
-                    out.append((K, Dm))
-            finally:
-                cm.data.frc_ncol[:] = grouped
+            out = grouped_and_column_jacobians(cm, m, 0.37, q, v)
+            assert np.array_equal(cm.data.frc_ncol, grouped)  # the colouring is back
             Q = m.Q(0.37, q, v)
             tol = 100 * np.finfo(float).eps / np.sqrt(np.finfo(float).eps) * max(1.0, float(np.max(np.abs(Q))))
             assert np.max(np.abs(out[0][0] - out[1][0])) <= tol

@@ -291,9 +291,8 @@ def test_wheel_rail_difference_jacobian_by_wheelset_groups_equals_column_by_colu
     depend on that wheelset's state alone) and the track speed control one per body: the
     difference Jacobian with the four wheelsets perturbed together equals the column-by-column
     one to the forward differences' round-off (ε|Q|/√ε relative), on the coach in contact."""
-    from core.compiled import dynamics as D
-    from core.compiled import protocol as P
     from core.compiled.layout import compile_model
+    from tests.core.test_compiled import grouped_and_column_jacobians
 
     veh, _ = coach
     m = veh.model
@@ -306,17 +305,8 @@ def test_wheel_rail_difference_jacobian_by_wheelset_groups_equals_column_by_colu
     k = [r.what for r in cm.force_kinds].index("wheel-rail contact")
     grouped = cm.data.frc_ncol.copy()
     assert grouped[k] == 1  # the four wheelsets share nothing: one colour
-    out = []
-    try:
-        for ncol in (grouped, -1):  # by column groups, then every column on its own
-            cm.data.frc_ncol[:] = ncol
-            ws, st = D.make_workspace(cm), cm.initial_states()
-            K, Dm = np.zeros((m.n_v, m.n_v)), np.zeros((m.n_v, m.n_v))
-            work = np.zeros(m.n_q), np.zeros(m.n_v), np.zeros(m.n_v), np.zeros(m.n_v)
-            assert D.force_jacobian(cm.data, st, ws, 0.0, q, v, K, Dm, *work) == P.OK
-            out.append((K, Dm))
-    finally:
-        cm.data.frc_ncol[:] = grouped
+    out = grouped_and_column_jacobians(cm, m, 0.0, q, v)
+    assert np.array_equal(cm.data.frc_ncol, grouped)  # the colouring is back
     Q = m.Q(0.0, q, v)
     tol = 100 * np.finfo(float).eps / np.sqrt(np.finfo(float).eps) * float(np.max(np.abs(Q)))
     assert np.max(np.abs(out[1][0])) > 1e6  # the contact stiffness is in it
